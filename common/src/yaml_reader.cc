@@ -1,0 +1,130 @@
+#include "trimbot/common/yaml_reader.h"
+
+#include <filesystem>
+
+namespace trimbot {
+namespace {
+
+std::string LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  if (mark.line < 0) return "";
+  return "line " + std::to_string(mark.line + 1) + ": ";
+}
+
+}  // namespace
+
+YamlMap YamlMap::LoadFile(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path, "line " + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw InputError(path, "expected a YAML map at the top level");
+  return YamlMap(root, path, "");
+}
+
+YamlMap::YamlMap(YAML::Node node, std::string file, std::string path_in_file)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path_in_file)) {
+  if (!node_.IsMap()) throw InputError(file_, LineOf(node_) + "'" + path_ + "' must be a map");
+}
+
+void YamlMap::Fail(const std::string& key, const std::string& problem) const {
+  const YAML::Node value = node_[key];
+  const std::string where = value.IsDefined() ? LineOf(value) : LineOf(node_);
+  const std::string full_key = path_.empty() ? key : path_ + "." + key;
+  throw InputError(file_, where + "key '" + full_key + "': " + problem);
+}
+
+bool YamlMap::Has(const std::string& key) const {
+  read_keys_.insert(key);
+  return node_[key].IsDefined() && !node_[key].IsNull();
+}
+
+YAML::Node YamlMap::Get(const std::string& key) const {
+  read_keys_.insert(key);
+  const YAML::Node value = node_[key];
+  if (!value.IsDefined() || value.IsNull()) Fail(key, "missing");
+  return value;
+}
+
+template <typename T>
+T YamlMap::As(const std::string& key, const char* type_name) const {
+  const YAML::Node value = Get(key);
+  if (!value.IsScalar()) Fail(key, std::string("expected a ") + type_name);
+  try {
+    return value.as<T>();
+  } catch (const YAML::Exception&) {
+    Fail(key, std::string("expected a ") + type_name + ", got '" + value.Scalar() + "'");
+  }
+}
+
+double YamlMap::Double(const std::string& key) const { return As<double>(key, "number"); }
+int YamlMap::Int(const std::string& key) const { return As<int>(key, "integer"); }
+bool YamlMap::Bool(const std::string& key) const { return As<bool>(key, "boolean"); }
+std::string YamlMap::String(const std::string& key) const { return As<std::string>(key, "string"); }
+
+double YamlMap::Double(const std::string& key, double fallback) const {
+  return Has(key) ? Double(key) : fallback;
+}
+int YamlMap::Int(const std::string& key, int fallback) const { return Has(key) ? Int(key) : fallback; }
+bool YamlMap::Bool(const std::string& key, bool fallback) const {
+  return Has(key) ? Bool(key) : fallback;
+}
+std::string YamlMap::String(const std::string& key, const std::string& fallback) const {
+  return Has(key) ? String(key) : fallback;
+}
+
+std::vector<double> YamlMap::Doubles(const std::string& key, int expected_size) const {
+  const YAML::Node value = Get(key);
+  if (!value.IsSequence()) Fail(key, "expected a list of numbers");
+  std::vector<double> out;
+  for (const auto& item : value) {
+    try {
+      out.push_back(item.as<double>());
+    } catch (const YAML::Exception&) {
+      Fail(key, "expected a list of numbers");
+    }
+  }
+  if (expected_size >= 0 && static_cast<int>(out.size()) != expected_size) {
+    Fail(key, "expected " + std::to_string(expected_size) + " numbers, got " +
+                  std::to_string(out.size()));
+  }
+  return out;
+}
+
+Eigen::Vector3d YamlMap::Vector3(const std::string& key) const {
+  const std::vector<double> v = Doubles(key, 3);
+  return {v[0], v[1], v[2]};
+}
+
+YamlMap YamlMap::Map(const std::string& key) const {
+  const YAML::Node value = Get(key);
+  if (!value.IsMap()) Fail(key, "expected a map");
+  return YamlMap(value, file_, path_.empty() ? key : path_ + "." + key);
+}
+
+std::vector<YamlMap> YamlMap::MapList(const std::string& key) const {
+  const YAML::Node value = Get(key);
+  if (!value.IsSequence()) Fail(key, "expected a list");
+  std::vector<YamlMap> out;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string item_path = (path_.empty() ? key : path_ + "." + key) + "[" + std::to_string(i) + "]";
+    if (!value[i].IsMap()) throw InputError(file_, LineOf(value[i]) + "'" + item_path + "' must be a map");
+    out.emplace_back(value[i], file_, item_path);
+  }
+  return out;
+}
+
+void YamlMap::RejectUnknownKeys() const {
+  for (const auto& entry : node_) {
+    const std::string key = entry.first.as<std::string>();
+    if (read_keys_.count(key) == 0) {
+      const std::string full_key = path_.empty() ? key : path_ + "." + key;
+      throw InputError(file_, LineOf(entry.first) + "unknown key '" + full_key + "'");
+    }
+  }
+}
+
+}  // namespace trimbot

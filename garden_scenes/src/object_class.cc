@@ -1,0 +1,71 @@
+#include "trimbot/garden/object_class.h"
+
+#include <array>
+#include <utility>
+
+namespace trimbot::garden {
+namespace {
+
+constexpr std::array<std::pair<ObjectClass, const char*>, 10> kClassNames = {{
+    {ObjectClass::kNone, "none"},
+    {ObjectClass::kGround, "ground"},
+    {ObjectClass::kTopiary, "topiary"},
+    {ObjectClass::kRose, "rose"},
+    {ObjectClass::kHedge, "hedge"},
+    {ObjectClass::kTree, "tree"},
+    {ObjectClass::kTrunk, "trunk"},
+    {ObjectClass::kFence, "fence"},
+    {ObjectClass::kObstacle, "obstacle"},
+    {ObjectClass::kRobot, "robot"},
+}};
+
+constexpr std::array<std::pair<Surface, const char*>, 3> kSurfaceNames = {{
+    {Surface::kGrass, "grass"},
+    {Surface::kGravel, "gravel"},
+    {Surface::kPavement, "pavement"},
+}};
+
+}  // namespace
+
+std::string ToString(ObjectClass c) {
+  for (const auto& [value, name] : kClassNames) {
+    if (value == c) return name;
+  }
+  return "unknown";
+}
+
+std::optional<ObjectClass> ObjectClassFromString(const std::string& name) {
+  for (const auto& [value, text] : kClassNames) {
+    if (name == text) return value;
+  }
+  return std::nullopt;
+}
+
+std::string ToString(Surface s) {
+  for (const auto& [value, name] : kSurfaceNames) {
+    if (value == s) return name;
+  }
+  return "unknown";
+}
+
+std::optional<Surface> SurfaceFromString(const std::string& name) {
+  for (const auto& [value, text] : kSurfaceNames) {
+    if (name == text) return value;
+  }
+  return std::nullopt;
+}
+
+SurfaceProperties PropertiesOf(Surface s) {
+  // Slip figures are typical of small wheeled robots: a few percent on grass, more on loose gravel.
+  switch (s) {
+    case Surface::kGrass:
+      return {0.8, {0.03, 0.015, 2.0}};
+    case Surface::kGravel:
+      return {0.7, {0.05, 0.025, 1.0}};
+    case Surface::kPavement:
+      return {1.0, {0.005, 0.003, 5.0}};
+  }
+  return {};
+}
+
+}  // namespace trimbot::garden

@@ -1,0 +1,55 @@
+#pragma once
+// The robot description: the URDF (parsed with urdfdom) and what is derived from it — frame
+// poses, the drive geometry, the arm joints. Simulator and stack read the same file.
+#include <urdf_model/model.h>
+#include <urdf_world/types.h>
+
+#include <Eigen/Geometry>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "trimbot/robot/diff_drive.h"
+
+namespace trimbot::robot {
+
+// Names the rest of the code relies on; the URDF must define them.
+struct RobotFrames {
+  static constexpr const char* kBase = "base_link";
+  static constexpr const char* kImu = "imu_link";
+  static constexpr const char* kCameraRing = "camera_ring_link";
+  static constexpr const char* kLeftWheelJoint = "left_wheel_joint";
+  static constexpr const char* kRightWheelJoint = "right_wheel_joint";
+  static constexpr const char* kLeftWheelLink = "left_wheel_link";
+  static constexpr const char* kEndEffector = "arm_end_effector";
+  static constexpr const char* kCutterJoint = "cutter_blade_joint";
+  static std::string CameraOptical(int index) { return "cam" + std::to_string(index) + "_optical_frame"; }
+  static std::string ArmJoint(int index) { return "arm_joint_" + std::to_string(index + 1); }
+};
+
+class RobotDescription {
+ public:
+  // Throws InputError naming the file if it is missing, malformed, or lacks a required frame.
+  static RobotDescription Load(const std::string& urdf_path);
+
+  const urdf::ModelInterface& urdf() const { return *model_; }
+  const std::string& path() const { return path_; }
+
+  // Pose of a link in base_link with every joint at the given position (default zero).
+  Eigen::Isometry3d FramePose(const std::string& link,
+                              const std::map<std::string, double>& joint_positions = {}) const;
+  // Pose of a child link in its parent link for the joint at position q.
+  static Eigen::Isometry3d JointTransform(const urdf::Joint& joint, double q);
+
+  DiffDriveGeometry drive() const { return drive_; }
+  std::vector<std::string> ArmJointNames() const;
+
+ private:
+  std::string path_;
+  urdf::ModelInterfaceSharedPtr model_;
+  DiffDriveGeometry drive_;
+};
+
+Eigen::Isometry3d ToIsometry(const urdf::Pose& pose);
+
+}  // namespace trimbot::robot

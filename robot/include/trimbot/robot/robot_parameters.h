@@ -1,0 +1,47 @@
+#pragma once
+// Parameters of the robot that the URDF does not carry (robot/config/robot_parameters.yaml).
+#include <array>
+#include <string>
+
+namespace trimbot::robot {
+
+struct ImuNoise {
+  std::string frame = "imu_link";
+  double rate_hz = 200.0;
+  double accelerometer_noise_density = 0.0;
+  double accelerometer_random_walk = 0.0;
+  double accelerometer_initial_bias_sigma = 0.0;
+  double gyroscope_noise_density = 0.0;
+  double gyroscope_random_walk = 0.0;
+  double gyroscope_initial_bias_sigma = 0.0;
+};
+
+struct WheelEncoderConfig {
+  double rate_hz = 50.0;
+  int ticks_per_revolution = 2048;
+};
+
+struct CameraTiming {
+  double rate_hz = 5.0;
+  double noise_sigma = 2.0;
+};
+
+struct DriveLimits {
+  double max_linear_acceleration = 0.5;
+  double max_angular_acceleration = 2.0;
+  double max_linear_speed = 0.6;
+  double max_angular_speed = 1.5;
+};
+
+struct RobotParameters {
+  ImuNoise imu;
+  WheelEncoderConfig wheel_encoders;
+  CameraTiming cameras;
+  DriveLimits drive;
+  std::array<double, 6> arm_home_position{};  // rad
+
+  // Throws InputError naming the file, line and key.
+  static RobotParameters Load(const std::string& path);
+};
+
+}  // namespace trimbot::robot

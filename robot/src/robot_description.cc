@@ -1,0 +1,122 @@
+#include "trimbot/robot/robot_description.h"
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <filesystem>
+#include <mutex>
+
+#include "trimbot/common/input_error.h"
+
+namespace trimbot::robot {
+namespace {
+
+// urdfdom reports parse errors through console_bridge; collect them so the InputError can say
+// what was wrong instead of "see above".
+class CollectingHandler : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) messages += (messages.empty() ? "" : "; ") + text;
+  }
+  std::string messages;
+};
+
+std::mutex parse_mutex;  // console_bridge's handler is global
+
+}  // namespace
+
+Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() << pose.position.x, pose.position.y, pose.position.z;
+  t.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+                   .normalized()
+                   .toRotationMatrix();
+  return t;
+}
+
+RobotDescription RobotDescription::Load(const std::string& urdf_path) {
+  if (!std::filesystem::is_regular_file(urdf_path)) throw InputError(urdf_path, "URDF file not found");
+  RobotDescription out;
+  out.path_ = urdf_path;
+  {
+    std::lock_guard<std::mutex> lock(parse_mutex);
+    CollectingHandler handler;
+    console_bridge::useOutputHandler(&handler);
+    out.model_ = urdf::parseURDFFile(urdf_path);
+    console_bridge::restorePreviousOutputHandler();
+    if (!out.model_) {
+      throw InputError(urdf_path, "malformed URDF: " + (handler.messages.empty() ? "parse failed" : handler.messages));
+    }
+  }
+  const auto& model = *out.model_;
+  if (model.getRoot() == nullptr || model.getRoot()->name != RobotFrames::kBase) {
+    throw InputError(urdf_path, std::string("the root link must be '") + RobotFrames::kBase + "'");
+  }
+  std::vector<std::string> required_links = {RobotFrames::kImu, RobotFrames::kCameraRing,
+                                             RobotFrames::kEndEffector, RobotFrames::kLeftWheelLink};
+  for (int i = 0; i < 10; ++i) required_links.push_back(RobotFrames::CameraOptical(i));
+  for (const auto& name : required_links) {
+    if (!model.getLink(name)) throw InputError(urdf_path, "missing link '" + name + "'");
+  }
+  std::vector<std::string> required_joints = {RobotFrames::kLeftWheelJoint, RobotFrames::kRightWheelJoint,
+                                              RobotFrames::kCutterJoint};
+  for (int i = 0; i < 6; ++i) required_joints.push_back(RobotFrames::ArmJoint(i));
+  for (const auto& name : required_joints) {
+    if (!model.getJoint(name)) throw InputError(urdf_path, "missing joint '" + name + "'");
+  }
+
+  // Drive geometry from the wheel joints and the wheel's collision cylinder.
+  const auto left = model.getJoint(RobotFrames::kLeftWheelJoint);
+  const auto right = model.getJoint(RobotFrames::kRightWheelJoint);
+  out.drive_.wheel_separation =
+      left->parent_to_joint_origin_transform.position.y - right->parent_to_joint_origin_transform.position.y;
+  const auto wheel = model.getLink(RobotFrames::kLeftWheelLink);
+  if (!wheel->collision || !wheel->collision->geometry ||
+      wheel->collision->geometry->type != urdf::Geometry::CYLINDER) {
+    throw InputError(urdf_path, "left_wheel_link needs a cylinder collision geometry (the wheel radius)");
+  }
+  out.drive_.wheel_radius = static_cast<const urdf::Cylinder&>(*wheel->collision->geometry).radius;
+  if (out.drive_.wheel_separation <= 0.0 || out.drive_.wheel_radius <= 0.0) {
+    throw InputError(urdf_path, "wheel joints must sit at +y (left) and -y (right) with a positive radius");
+  }
+  return out;
+}
+
+Eigen::Isometry3d RobotDescription::JointTransform(const urdf::Joint& joint, double q) {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d axis(joint.axis.x, joint.axis.y, joint.axis.z);
+  switch (joint.type) {
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS:
+      motion.linear() = Eigen::AngleAxisd(q, axis.normalized()).toRotationMatrix();
+      break;
+    case urdf::Joint::PRISMATIC:
+      motion.translation() = q * axis.normalized();
+      break;
+    default:
+      break;
+  }
+  return ToIsometry(joint.parent_to_joint_origin_transform) * motion;
+}
+
+Eigen::Isometry3d RobotDescription::FramePose(const std::string& link,
+                                              const std::map<std::string, double>& joint_positions) const {
+  auto current = model_->getLink(link);
+  if (!current) throw InputError(path_, "no link named '" + link + "'");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  while (current->parent_joint) {
+    const auto& joint = *current->parent_joint;
+    const auto q = joint_positions.find(joint.name);
+    pose = JointTransform(joint, q == joint_positions.end() ? 0.0 : q->second) * pose;
+    current = model_->getLink(joint.parent_link_name);
+  }
+  return pose;
+}
+
+std::vector<std::string> RobotDescription::ArmJointNames() const {
+  std::vector<std::string> names;
+  for (int i = 0; i < 6; ++i) names.push_back(RobotFrames::ArmJoint(i));
+  return names;
+}
+
+}  // namespace trimbot::robot

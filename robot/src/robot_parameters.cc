@@ -1,0 +1,66 @@
+#include "trimbot/robot/robot_parameters.h"
+
+#include <algorithm>
+
+#include "trimbot/common/yaml_reader.h"
+
+namespace trimbot::robot {
+namespace {
+
+double Positive(const YamlMap& map, const std::string& key) {
+  const double value = map.Double(key);
+  if (!(value > 0.0)) map.Fail(key, "must be positive");
+  return value;
+}
+
+double NonNegative(const YamlMap& map, const std::string& key) {
+  const double value = map.Double(key);
+  if (!(value >= 0.0)) map.Fail(key, "must not be negative");
+  return value;
+}
+
+}  // namespace
+
+RobotParameters RobotParameters::Load(const std::string& path) {
+  const YamlMap root = YamlMap::LoadFile(path);
+  RobotParameters config;
+
+  const YamlMap imu = root.Map("imu");
+  config.imu.frame = imu.String("frame");
+  config.imu.rate_hz = Positive(imu, "rate_hz");
+  config.imu.accelerometer_noise_density = NonNegative(imu, "accelerometer_noise_density");
+  config.imu.accelerometer_random_walk = NonNegative(imu, "accelerometer_random_walk");
+  config.imu.accelerometer_initial_bias_sigma = NonNegative(imu, "accelerometer_initial_bias_sigma");
+  config.imu.gyroscope_noise_density = NonNegative(imu, "gyroscope_noise_density");
+  config.imu.gyroscope_random_walk = NonNegative(imu, "gyroscope_random_walk");
+  config.imu.gyroscope_initial_bias_sigma = NonNegative(imu, "gyroscope_initial_bias_sigma");
+  imu.RejectUnknownKeys();
+
+  const YamlMap encoders = root.Map("wheel_encoders");
+  config.wheel_encoders.rate_hz = Positive(encoders, "rate_hz");
+  config.wheel_encoders.ticks_per_revolution = encoders.Int("ticks_per_revolution");
+  if (config.wheel_encoders.ticks_per_revolution <= 0) encoders.Fail("ticks_per_revolution", "must be positive");
+  encoders.RejectUnknownKeys();
+
+  const YamlMap cameras = root.Map("cameras");
+  config.cameras.rate_hz = Positive(cameras, "rate_hz");
+  config.cameras.noise_sigma = NonNegative(cameras, "noise_sigma");
+  cameras.RejectUnknownKeys();
+
+  const YamlMap drive = root.Map("drive");
+  config.drive.max_linear_acceleration = Positive(drive, "max_linear_acceleration");
+  config.drive.max_angular_acceleration = Positive(drive, "max_angular_acceleration");
+  config.drive.max_linear_speed = Positive(drive, "max_linear_speed");
+  config.drive.max_angular_speed = Positive(drive, "max_angular_speed");
+  drive.RejectUnknownKeys();
+
+  const YamlMap arm = root.Map("arm");
+  const auto home = arm.Doubles("home_position", 6);
+  std::copy(home.begin(), home.end(), config.arm_home_position.begin());
+  arm.RejectUnknownKeys();
+
+  root.RejectUnknownKeys();
+  return config;
+}
+
+}  // namespace trimbot::robot

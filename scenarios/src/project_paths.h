@@ -1,0 +1,19 @@
+#pragma once
+// Where the project's data files live (robot description, calibration, gardens). Defaults to the
+// source tree the binary was built from; --data-root points elsewhere (e.g. an installed copy).
+#include <string>
+
+namespace trimbot::scenarios {
+
+struct ProjectPaths {
+  std::string root;
+
+  std::string urdf() const { return root + "/robot/urdf/trimbot.urdf"; }
+  std::string nominal_calibration() const { return root + "/robot/calibration/nominal_camchain.yaml"; }
+  std::string robot_parameters() const { return root + "/robot/config/robot_parameters.yaml"; }
+  std::string gardens_dir() const { return root + "/garden_scenes/gardens"; }
+
+  static ProjectPaths Default();
+};
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,118 @@
+#pragma once
+// The simulated robot in its garden, as one system with explicit inputs, outputs and state:
+//   inputs   base velocity command, arm command, cutter command
+//   outputs  sensor messages (IMU, wheel ticks, ring frames) - what the stack may see
+//   state    MuJoCo state + sensor-model state; ground truth is read separately and goes only to
+//            the evaluation.
+// Time advances in fixed physics steps; every sensor runs at an integer number of steps, and all
+// noise comes from streams seeded by `seed`, so a run is reproduced exactly by its seed.
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "trimbot/garden/garden.h"
+#include "trimbot/messages/commands.h"
+#include "trimbot/messages/sensor_messages.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_parameters.h"
+#include "trimbot/sim/ring_renderer.h"
+#include "trimbot/sim/world_builder.h"
+
+namespace trimbot::sim {
+
+struct SimulatorConfig {
+  std::string urdf_path;
+  std::string calibration_path;      // Kalibr camchain: the cameras as they really are
+  std::string robot_parameters_path;
+  std::string garden_path;
+  std::string world_dir;             // where world.xml and its textures are written
+  std::uint64_t seed = 0;
+  Pose2D start;
+  double timestep = 0.0025;          // s
+  bool render_cameras = true;
+  bool render_ground_truth = false;  // depth and label images with every ring frame
+  double resolution_scale = 1.0;     // 0.5 renders half-resolution images
+};
+
+// Ground truth at the current time, in the map frame (MuJoCo's world frame).
+struct GroundTruth {
+  double stamp = 0.0;
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d linear_velocity_base = Eigen::Vector3d::Zero();   // in base_link
+  Eigen::Vector3d angular_velocity_base = Eigen::Vector3d::Zero();  // in base_link
+  std::array<double, messages::kArmJoints> arm_position{};
+  Eigen::Isometry3d T_map_end_effector = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d accelerometer_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyroscope_bias = Eigen::Vector3d::Zero();
+};
+
+// A contact between the robot and a garden object other than the ground.
+struct ObstacleContact {
+  std::string robot_geom;
+  std::string object_geom;
+  garden::ObjectClass object_class = garden::ObjectClass::kNone;
+};
+
+struct RingCapture {
+  messages::RingFrame frame;                      // sensor output (noisy images)
+  std::vector<RenderedView> ground_truth;         // depth/labels when render_ground_truth
+  std::vector<Eigen::Isometry3d> T_map_camera;    // true optical-frame poses
+};
+
+struct StepOutputs {
+  std::vector<messages::ImuSample> imu;
+  std::vector<messages::WheelTicks> wheel_ticks;
+  std::optional<RingCapture> ring;
+  void Clear() {
+    imu.clear();
+    wheel_ticks.clear();
+    ring.reset();
+  }
+};
+
+class Simulator {
+ public:
+  explicit Simulator(const SimulatorConfig& config);
+  ~Simulator();
+
+  // Inputs.
+  void SetBaseCommand(const messages::BaseVelocityCommand& command);
+  void SetArmCommand(const messages::ArmCommand& command);
+  void SetCutterCommand(const messages::CutterCommand& command);
+
+  // One physics step; sensor messages due in it are appended to `outputs`.
+  void Step(StepOutputs* outputs);
+  double time() const;
+  double timestep() const { return config_.timestep; }
+
+  GroundTruth ground_truth() const;
+  std::vector<ObstacleContact> ObstacleContacts() const;
+
+  const robot::RobotDescription& robot() const { return robot_; }
+  const robot::CameraRig& rig() const { return rig_; }
+  const robot::RobotParameters& parameters() const { return parameters_; }
+  const garden::Garden& garden() const { return garden_; }
+  const WorldSpec& world_spec() const { return spec_; }
+  // Renders the cameras now (outside the camera schedule), e.g. for tests and benchmarks.
+  RingCapture CaptureRing(bool with_ground_truth);
+  class World& world();
+
+ private:
+  const garden::SlipModel* SurfaceUnder(int wheel_geom) const;
+
+  SimulatorConfig config_;
+  robot::RobotDescription robot_;
+  robot::RobotParameters parameters_;
+  robot::CameraRig rig_;
+  garden::Garden garden_;
+  WorldSpec spec_;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace trimbot::sim

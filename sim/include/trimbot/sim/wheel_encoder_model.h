@@ -1,0 +1,42 @@
+#pragma once
+// Wheel encoders: quantized counts of wheel rotation, with slip. MuJoCo's Coulomb contact does
+// not produce the small continuous slip of a tyre on grass, so slip is applied here: while a
+// wheel is on the ground it turns (1 + s) times as far as its contact point travels, with s from
+// the surface's Gauss-Markov slip model. Odometry from these counts therefore over-estimates the
+// distance travelled, as on the real lawn.
+#include <cstdint>
+#include <random>
+
+#include "trimbot/common/random.h"
+#include "trimbot/garden/object_class.h"
+#include "trimbot/messages/sensor_messages.h"
+
+namespace trimbot::sim {
+
+class WheelEncoderModel {
+ public:
+  WheelEncoderModel(int ticks_per_revolution, std::uint64_t seed);
+
+  // Advances by the true rotation of each wheel (rad) over dt; `surface` is the ground under the
+  // wheel or nullptr when the wheel touches nothing.
+  void Advance(double dt, double rotation_left, double rotation_right, const garden::SlipModel* surface_left,
+               const garden::SlipModel* surface_right);
+  messages::WheelTicks Read(double stamp) const;
+  // Fault: add extra slip for a while (a muddy patch); fraction added to both wheels.
+  void SetExtraSlip(double fraction) { extra_slip_ = fraction; }
+
+ private:
+  struct Wheel {
+    double measured_angle = 0.0;  // rad, what the encoder has seen
+    double slip_state = 0.0;      // Gauss-Markov deviation from the mean slip
+  };
+  void AdvanceWheel(Wheel& wheel, double dt, double rotation, const garden::SlipModel* surface);
+
+  int ticks_per_revolution_;
+  Rng rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  Wheel left_, right_;
+  double extra_slip_ = 0.0;
+};
+
+}  // namespace trimbot::sim

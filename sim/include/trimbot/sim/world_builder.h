@@ -1,0 +1,46 @@
+#pragma once
+// Composes the MuJoCo world (MJCF) from the robot description (URDF), the camera calibration and
+// a garden. The MJCF is written next to the run's outputs (world/world.xml with its textures), so
+// any run's world can be opened and inspected in MuJoCo's viewer.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "trimbot/garden/garden.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
+
+namespace trimbot::sim {
+
+struct Pose2D {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+};
+
+struct WorldOptions {
+  double timestep = 0.002;        // s, fixed physics step
+  Pose2D start;                   // base_link in the map frame
+  std::uint64_t seed = 0;         // seeds the garden textures
+  int texture_size = 1024;        // px per texture tile
+  double render_oversampling = 1.0;
+};
+
+// What the label images report for a geom.
+struct GeomLabel {
+  std::string geom_name;
+  garden::ObjectClass object_class = garden::ObjectClass::kNone;
+  std::uint16_t object_id = 0;
+  bool is_ground = false;
+  garden::Surface surface = garden::Surface::kGrass;  // meaningful when is_ground
+};
+
+struct WorldSpec {
+  std::string mjcf_path;           // world.xml written to disk
+  std::vector<GeomLabel> labels;   // every named geom that can appear in a label image
+  std::vector<std::string> camera_names;  // MuJoCo camera i renders rig camera i
+};
+
+WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig,
+                       const garden::Garden& garden, const WorldOptions& options,
+                       const std::string& output_dir);
+
+}  // namespace trimbot::sim

@@ -1,0 +1,247 @@
+#include "trimbot/sim/simulator.h"
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+
+#include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
+#include "trimbot/sim/arm_controller.h"
+#include "trimbot/sim/base_controller.h"
+#include "trimbot/sim/imu_model.h"
+#include "trimbot/sim/wheel_encoder_model.h"
+#include "trimbot/sim/world.h"
+
+namespace trimbot::sim {
+
+using robot::RobotFrames;
+
+namespace {
+
+// Number of physics steps per sensor sample; the rate must divide the physics rate.
+int StepsPerSample(double rate_hz, double timestep, const std::string& file, const std::string& sensor) {
+  const double steps = 1.0 / (rate_hz * timestep);
+  const long rounded = std::lround(steps);
+  if (rounded < 1 || std::abs(steps - static_cast<double>(rounded)) > 1e-6) {
+    throw InputError(file, sensor + " rate " + std::to_string(rate_hz) + " Hz is not the physics rate (" +
+                               std::to_string(1.0 / timestep) + " Hz) divided by a whole number");
+  }
+  return static_cast<int>(rounded);
+}
+
+Eigen::Isometry3d PoseFromMujoco(const mjtNum* pos, const mjtNum* mat) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << pos[0], pos[1], pos[2];
+  pose.linear() << mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7], mat[8];
+  return pose;
+}
+
+}  // namespace
+
+struct Simulator::Impl {
+  std::unique_ptr<World> world;
+  std::unique_ptr<RingRenderer> renderer;
+  std::unique_ptr<BaseController> base;
+  std::unique_ptr<ArmController> arm;
+  std::unique_ptr<ImuModel> imu;
+  std::unique_ptr<WheelEncoderModel> encoders;
+  bool cutter_on = false;
+  long step = 0;
+  long frame = 0;
+  int imu_steps = 1, encoder_steps = 1, camera_steps = 1;
+  double last_left_angle = 0.0, last_right_angle = 0.0;
+  garden::SlipModel ground_slip[3];
+};
+
+Simulator::Simulator(const SimulatorConfig& config)
+    : config_(config),
+      robot_(robot::RobotDescription::Load(config.urdf_path)),
+      parameters_(robot::RobotParameters::Load(config.robot_parameters_path)),
+      rig_(robot::CameraRig::LoadKalibr(config.calibration_path,
+                                        robot_.FramePose(RobotFrames::CameraOptical(0)))),
+      garden_(garden::Garden::Load(config.garden_path)),
+      impl_(std::make_unique<Impl>()) {
+  if (rig_.size() != 10) {
+    throw InputError(config.calibration_path, "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));
+  }
+  WorldOptions options;
+  options.timestep = config.timestep;
+  options.start = config.start;
+  options.seed = config.seed;
+  spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);
+  impl_->world = std::make_unique<World>(spec_);
+
+  const std::string& params = config.robot_parameters_path;
+  impl_->imu_steps = StepsPerSample(parameters_.imu.rate_hz, config.timestep, params, "IMU");
+  impl_->encoder_steps = StepsPerSample(parameters_.wheel_encoders.rate_hz, config.timestep, params, "wheel encoder");
+  impl_->camera_steps = StepsPerSample(parameters_.cameras.rate_hz, config.timestep, params, "camera");
+
+  impl_->base = std::make_unique<BaseController>(robot_.drive(), parameters_.drive);
+  impl_->imu = std::make_unique<ImuModel>(parameters_.imu, config.seed);
+  impl_->encoders = std::make_unique<WheelEncoderModel>(parameters_.wheel_encoders.ticks_per_revolution, config.seed);
+  for (auto surface : {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement}) {
+    impl_->ground_slip[static_cast<int>(surface)] = garden::PropertiesOf(surface).slip;
+  }
+
+  // The arm starts in its home pose, held by its servos.
+  mjModel* m = impl_->world->model();
+  mjData* d = impl_->world->data();
+  std::array<JointRange, messages::kArmJoints> ranges{};
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    const auto& joint = impl_->world->arm()[i];
+    d->qpos[joint.qpos] = parameters_.arm_home_position[i];
+    ranges[i] = {m->jnt_limited[joint.joint] != 0, m->jnt_range[2 * joint.joint], m->jnt_range[2 * joint.joint + 1]};
+  }
+  impl_->arm = std::make_unique<ArmController>(parameters_.arm_home_position, ranges);
+  mj_forward(m, d);
+
+  if (config.render_cameras) {
+    impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.resolution_scale);
+  }
+}
+
+Simulator::~Simulator() = default;
+
+World& Simulator::world() { return *impl_->world; }
+
+void Simulator::SetBaseCommand(const messages::BaseVelocityCommand& command) { impl_->base->SetCommand(command); }
+void Simulator::SetArmCommand(const messages::ArmCommand& command) { impl_->arm->SetCommand(command); }
+void Simulator::SetCutterCommand(const messages::CutterCommand& command) { impl_->cutter_on = command.on; }
+
+double Simulator::time() const { return impl_->world->data()->time; }
+
+const garden::SlipModel* Simulator::SurfaceUnder(int wheel_geom) const {
+  const World& world = *impl_->world;
+  const mjData* d = world.data();
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& contact = d->contact[i];
+    int other = -1;
+    if (contact.geom1 == wheel_geom) other = contact.geom2;
+    if (contact.geom2 == wheel_geom) other = contact.geom1;
+    const GeomLabel* label = world.label(other);
+    if (label != nullptr && label->is_ground) return &impl_->ground_slip[static_cast<int>(label->surface)];
+  }
+  return nullptr;
+}
+
+void Simulator::Step(StepOutputs* outputs) {
+  World& world = *impl_->world;
+  mjModel* m = world.model();
+  mjData* d = world.data();
+  const double dt = config_.timestep;
+
+  // Actuation.
+  const robot::WheelSpeeds wheels = impl_->base->Update(dt);
+  d->ctrl[world.left_wheel().actuator] = wheels.left;
+  d->ctrl[world.right_wheel().actuator] = wheels.right;
+  const auto& arm_target = impl_->arm->Update(dt);
+  for (size_t i = 0; i < arm_target.size(); ++i) {
+    const auto& joint = world.arm()[i];
+    d->ctrl[joint.actuator] = arm_target[i];
+    d->qfrc_applied[joint.dof] = d->qfrc_bias[joint.dof];  // the arm firmware's gravity compensation
+  }
+  d->ctrl[world.cutter().actuator] = impl_->cutter_on ? 300.0 : 0.0;
+
+  const double stamp_before = d->time;
+  mj_step(m, d);
+  ++impl_->step;
+
+  // IMU: MuJoCo's sensors were evaluated at the start of the step.
+  if (impl_->step % impl_->imu_steps == 0) {
+    const Eigen::Map<const Eigen::Vector3d> accel(d->sensordata + world.accelerometer_adr());
+    const Eigen::Map<const Eigen::Vector3d> gyro(d->sensordata + world.gyro_adr());
+    outputs->imu.push_back(impl_->imu->Measure(stamp_before, accel, gyro, impl_->imu_steps * dt));
+  }
+
+  // Encoders integrate every step (slip depends on the surface under each wheel).
+  const double left_angle = d->qpos[world.left_wheel().qpos];
+  const double right_angle = d->qpos[world.right_wheel().qpos];
+  impl_->encoders->Advance(dt, left_angle - impl_->last_left_angle, right_angle - impl_->last_right_angle,
+                           SurfaceUnder(world.left_wheel_geom()), SurfaceUnder(world.right_wheel_geom()));
+  impl_->last_left_angle = left_angle;
+  impl_->last_right_angle = right_angle;
+  if (impl_->step % impl_->encoder_steps == 0) outputs->wheel_ticks.push_back(impl_->encoders->Read(d->time));
+
+  if (impl_->renderer && impl_->step % impl_->camera_steps == 0) {
+    outputs->ring = CaptureRing(config_.render_ground_truth);
+  }
+}
+
+RingCapture Simulator::CaptureRing(bool with_ground_truth) {
+  if (!impl_->renderer) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
+  World& world = *impl_->world;
+  mj_forward(world.model(), world.data());  // kinematics at the current time
+  RingCapture capture;
+  capture.frame.stamp = world.data()->time;
+  for (int i = 0; i < rig_.size(); ++i) {
+    RenderedView view = impl_->renderer->Render(i, with_ground_truth);
+    // Sensor noise, seeded per frame and camera so each image is reproducible on its own.
+    if (parameters_.cameras.noise_sigma > 0.0) {
+      cv::RNG rng(StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i)));
+      cv::Mat noise(view.rgb.size(), CV_16SC3);
+      rng.fill(noise, cv::RNG::NORMAL, 0.0, parameters_.cameras.noise_sigma);
+      cv::Mat noisy;
+      cv::add(view.rgb, noise, noisy, cv::noArray(), CV_8UC3);
+      view.rgb = noisy;
+    }
+    messages::Image image;
+    image.stamp = capture.frame.stamp;
+    image.camera_index = i;
+    image.width = view.rgb.cols;
+    image.height = view.rgb.rows;
+    image.encoding = "rgb8";
+    image.data.assign(view.rgb.data, view.rgb.data + view.rgb.total() * view.rgb.elemSize());
+    capture.frame.images.push_back(std::move(image));
+
+    const int id = world.camera_id(i);
+    Eigen::Isometry3d T_map_camera = PoseFromMujoco(world.data()->cam_xpos + 3 * id, world.data()->cam_xmat + 9 * id);
+    T_map_camera.linear() = T_map_camera.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    capture.T_map_camera.push_back(T_map_camera);
+    if (with_ground_truth) capture.ground_truth.push_back(std::move(view));
+  }
+  ++impl_->frame;
+  return capture;
+}
+
+GroundTruth Simulator::ground_truth() const {
+  const World& world = *impl_->world;
+  const mjModel* m = world.model();
+  const mjData* d = world.data();
+  GroundTruth truth;
+  truth.stamp = d->time;
+  // The free joint's qpos is the state at d->time (xpos lags by a step after mj_step).
+  const int qpos = m->jnt_qposadr[m->body_jntadr[world.base_body()]];
+  const int dof = m->jnt_dofadr[m->body_jntadr[world.base_body()]];
+  truth.T_map_base.translation() << d->qpos[qpos], d->qpos[qpos + 1], d->qpos[qpos + 2];
+  const Eigen::Quaterniond q(d->qpos[qpos + 3], d->qpos[qpos + 4], d->qpos[qpos + 5], d->qpos[qpos + 6]);
+  truth.T_map_base.linear() = q.normalized().toRotationMatrix();
+  // Free joint velocity: linear in the world frame, angular in the body frame.
+  const Eigen::Vector3d linear_world(d->qvel[dof], d->qvel[dof + 1], d->qvel[dof + 2]);
+  truth.linear_velocity_base = truth.T_map_base.linear().transpose() * linear_world;
+  truth.angular_velocity_base << d->qvel[dof + 3], d->qvel[dof + 4], d->qvel[dof + 5];
+  for (size_t i = 0; i < truth.arm_position.size(); ++i) truth.arm_position[i] = d->qpos[world.arm()[i].qpos];
+  const int ee = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
+  if (ee >= 0) truth.T_map_end_effector = PoseFromMujoco(d->xpos + 3 * ee, d->xmat + 9 * ee);
+  truth.accelerometer_bias = impl_->imu->accelerometer_bias();
+  truth.gyroscope_bias = impl_->imu->gyroscope_bias();
+  return truth;
+}
+
+std::vector<ObstacleContact> Simulator::ObstacleContacts() const {
+  const World& world = *impl_->world;
+  const mjData* d = world.data();
+  std::vector<ObstacleContact> contacts;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& contact = d->contact[i];
+    for (const auto& [robot_geom, other] : {std::pair{contact.geom1, contact.geom2}, std::pair{contact.geom2, contact.geom1}}) {
+      const GeomLabel* object = world.label(other);
+      if (world.is_robot_geom(robot_geom) && object != nullptr && !object->is_ground &&
+          object->object_class != garden::ObjectClass::kRobot) {
+        contacts.push_back({mj_id2name(world.model(), mjOBJ_GEOM, robot_geom), object->geom_name, object->object_class});
+      }
+    }
+  }
+  return contacts;
+}
+
+}  // namespace trimbot::sim

@@ -1,0 +1,35 @@
+#pragma once
+// Dead reckoning from wheel encoder counts: the odom -> base_link pose of REP-105.
+#include <cstdint>
+#include <optional>
+
+#include "trimbot/messages/sensor_messages.h"
+#include "trimbot/robot/diff_drive.h"
+
+namespace trimbot::stack {
+
+struct Pose2 {
+  double x = 0.0, y = 0.0, yaw = 0.0;
+};
+
+class WheelOdometry {
+ public:
+  WheelOdometry(const robot::DiffDriveGeometry& geometry, int ticks_per_revolution)
+      : geometry_(geometry), radians_per_tick_(2.0 * 3.14159265358979323846 / ticks_per_revolution) {}
+
+  // Integrates the motion since the previous reading (midpoint rule on the heading).
+  void Update(const messages::WheelTicks& ticks);
+  const Pose2& pose() const { return pose_; }
+  double linear_velocity() const { return linear_velocity_; }
+  double angular_velocity() const { return angular_velocity_; }
+
+ private:
+  robot::DiffDriveGeometry geometry_;
+  double radians_per_tick_;
+  std::optional<messages::WheelTicks> last_;
+  Pose2 pose_;
+  double linear_velocity_ = 0.0;
+  double angular_velocity_ = 0.0;
+};
+
+}  // namespace trimbot::stack
