@@ -8,4 +8,7 @@ foreach(module IN LISTS TRIMBOT_OPENCV_MODULES)
   set_target_properties(opencv_${module} PROPERTIES
     IMPORTED_LOCATION "${OpenCV_${module}_LIBRARY}"
     INTERFACE_INCLUDE_DIRECTORIES "${OpenCV_INCLUDE_DIR}")
+  if(NOT module STREQUAL "core")
+    set_property(TARGET opencv_${module} PROPERTY INTERFACE_LINK_LIBRARIES opencv_core)
+  endif()
 endforeach()

@@ -131,9 +131,11 @@ void Simulator::Step(StepOutputs* outputs) {
   const double dt = config_.timestep;
 
   // Actuation.
-  const robot::WheelSpeeds wheels = impl_->base->Update(dt);
-  d->ctrl[world.left_wheel().actuator] = wheels.left;
-  d->ctrl[world.right_wheel().actuator] = wheels.right;
+  impl_->base->Update(dt);
+  const robot::WheelSpeeds setpoints =
+      impl_->base->ActuatorSetpoints({d->qvel[world.left_wheel().dof], d->qvel[world.right_wheel().dof]}, dt);
+  d->ctrl[world.left_wheel().actuator] = setpoints.left;
+  d->ctrl[world.right_wheel().actuator] = setpoints.right;
   const auto& arm_target = impl_->arm->Update(dt);
   for (size_t i = 0; i < arm_target.size(); ++i) {
     const auto& joint = world.arm()[i];

@@ -1,0 +1,192 @@
+// Rendered cameras against the calibration: targets land where the camera model predicts, depth
+// is metric, a stereo pair's disparity is f*B/Z, and the same seed gives the same bytes.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+
+#include "sim_test_support.h"
+
+namespace trimbot::sim {
+namespace {
+
+using testing::SourcePath;
+using testing::TestConfig;
+
+std::string Targets() { return SourcePath("tests/data/camera_targets.yaml"); }
+
+// Centroid (in pixels) of the pixels labelled with an object id; nullopt if too few.
+std::optional<Eigen::Vector2d> Centroid(const cv::Mat& object_id, int id) {
+  double sum_u = 0, sum_v = 0;
+  int n = 0;
+  for (int v = 0; v < object_id.rows; ++v) {
+    for (int u = 0; u < object_id.cols; ++u) {
+      if (object_id.at<uint16_t>(v, u) == id) {
+        sum_u += u;
+        sum_v += v;
+        ++n;
+      }
+    }
+  }
+  if (n < 10) return std::nullopt;
+  return Eigen::Vector2d(sum_u / n, sum_v / n);
+}
+
+Eigen::Vector3d TargetCentre(const garden::Garden& garden, int id) {
+  for (const auto& object : garden.objects) {
+    if (object.id == id) {
+      return {object.position.x(), object.position.y(), object.base_height + object.size.z() / 2};
+    }
+  }
+  throw std::runtime_error("no target " + std::to_string(id));
+}
+
+class RenderedTargets : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    simulator_ = new Simulator(TestConfig(Targets(), "targets", true));
+    capture_ = new RingCapture(simulator_->CaptureRing(true));
+  }
+  static void TearDownTestSuite() {
+    delete capture_;
+    delete simulator_;
+  }
+  // Camera pose from ground truth of the base and the calibration (not from the renderer).
+  static Eigen::Isometry3d T_map_camera(int index) {
+    return simulator_->ground_truth().T_map_base * simulator_->rig().camera(index).T_base_camera;
+  }
+  static Simulator* simulator_;
+  static RingCapture* capture_;
+};
+Simulator* RenderedTargets::simulator_ = nullptr;
+RingCapture* RenderedTargets::capture_ = nullptr;
+
+TEST_F(RenderedTargets, TargetsLandWhereTheCalibrationProjectsThem) {
+  const auto& camera = simulator_->rig().camera(0).intrinsics;
+  const cv::Mat& ids = capture_->ground_truth[0].object_id;
+  int checked = 0;
+  double worst = 0.0;
+  for (int id = 11; id <= 17; ++id) {
+    const Eigen::Vector3d in_camera = T_map_camera(0).inverse() * TargetCentre(simulator_->garden(), id);
+    const Eigen::Vector2d predicted = camera.Project(in_camera);
+    const auto centroid = Centroid(ids, id);
+    ASSERT_TRUE(centroid.has_value()) << "target " << id << " not visible";
+    EXPECT_LT((*centroid - predicted).norm(), 1.0)
+        << "target " << id << " at " << centroid->transpose() << ", predicted " << predicted.transpose();
+    worst = std::max(worst, (*centroid - predicted).norm());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 7);
+  std::printf("projection: worst target error %.3f px over %d targets\n", worst, checked);
+  // Off-axis targets test the distortion: they are far from the principal point.
+  const Eigen::Vector2d corner_target = camera.Project(T_map_camera(0).inverse() * TargetCentre(simulator_->garden(), 17));
+  EXPECT_GT((corner_target - Eigen::Vector2d(camera.cx, camera.cy)).norm(), 250.0);
+}
+
+TEST_F(RenderedTargets, DepthOfTheWallIsThreeMetres) {
+  const cv::Mat& depth = capture_->ground_truth[0].depth;
+  const cv::Mat& ids = capture_->ground_truth[0].object_id;
+  int n = 0;
+  double worst = 0.0;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      if (ids.at<uint16_t>(v, u) != 1) continue;
+      // Skip the wall's silhouette, where nearest-neighbour resampling may pick a neighbour.
+      bool interior = v > 0 && u > 0 && v + 1 < depth.rows && u + 1 < depth.cols;
+      for (int dv = -1; interior && dv <= 1; ++dv) {
+        for (int du = -1; interior && du <= 1; ++du) interior = ids.at<uint16_t>(v + dv, u + du) == 1;
+      }
+      if (!interior) continue;
+      worst = std::max(worst, std::abs(depth.at<float>(v, u) - 3.0));
+      ++n;
+    }
+  }
+  EXPECT_GT(n, 50000);
+  EXPECT_LT(worst, 0.01);
+  std::printf("depth: worst error %.5f m over %d wall pixels at 3 m\n", worst, n);
+}
+
+TEST_F(RenderedTargets, StereoDisparityIsFocalTimesBaselineOverDepth) {
+  const auto pair = simulator_->rig().StereoPairs()[0];
+  const auto& left = simulator_->rig().camera(pair.left).intrinsics;
+  const auto& right = simulator_->rig().camera(pair.right).intrinsics;
+  double worst = 0.0;
+  for (int id = 11; id <= 17; ++id) {
+    const auto centroid_left = Centroid(capture_->ground_truth[pair.left].object_id, id);
+    const auto centroid_right = Centroid(capture_->ground_truth[pair.right].object_id, id);
+    ASSERT_TRUE(centroid_left && centroid_right) << "target " << id;
+    // Undistort both centroids: the nominal pair is parallel, so disparity is along x only.
+    const Eigen::Vector2d ray_left = left.Undistort(*centroid_left);
+    const Eigen::Vector2d ray_right = right.Undistort(*centroid_right);
+    const double disparity = left.fx * (ray_left.x() - ray_right.x());
+    const double depth = (T_map_camera(pair.left).inverse() * TargetCentre(simulator_->garden(), id)).z();
+    EXPECT_NEAR(disparity, left.fx * pair.baseline / depth, 0.25) << "target " << id << " at " << depth << " m";
+    worst = std::max(worst, std::abs(disparity - left.fx * pair.baseline / depth));
+    EXPECT_NEAR(ray_left.y(), ray_right.y(), 0.25 / left.fy) << "target " << id;  // same row after rectification
+  }
+  std::printf("stereo: worst disparity error %.3f px (f*B/Z from 16.2 px at 1 m to 5.8 px at 2.8 m)\n", worst);
+}
+
+TEST_F(RenderedTargets, LabelsNameTheObjectsAndTheGround) {
+  const cv::Mat& classes = capture_->ground_truth[0].object_class;
+  std::map<int, int> count;
+  for (int v = 0; v < classes.rows; ++v) {
+    for (int u = 0; u < classes.cols; ++u) ++count[classes.at<uchar>(v, u)];
+  }
+  EXPECT_GT(count[static_cast<int>(garden::ObjectClass::kGround)], 10000);
+  EXPECT_GT(count[static_cast<int>(garden::ObjectClass::kObstacle)], 50000);
+  // The sky above the wall is "nothing"; no pixel carries an unknown class.
+  for (const auto& [value, n] : count) EXPECT_LE(value, static_cast<int>(garden::ObjectClass::kRobot));
+}
+
+// Same scenario and seed: the same bytes in images and IMU samples; another seed differs.
+struct Recording {
+  std::vector<std::vector<uint8_t>> images;
+  std::vector<messages::ImuSample> imu;
+  std::vector<messages::WheelTicks> ticks;
+};
+
+Recording Record(std::uint64_t seed, const std::string& name) {
+  SimulatorConfig config = TestConfig(testing::TestLawn(), name, true);
+  config.seed = seed;
+  config.resolution_scale = 0.5;
+  Simulator simulator(config);
+  simulator.SetBaseCommand({0.25, 0.1});
+  Recording recording;
+  StepOutputs outputs;
+  while (simulator.time() < 0.45) {  // two ring frames at 5 Hz
+    outputs.Clear();
+    simulator.Step(&outputs);
+    recording.imu.insert(recording.imu.end(), outputs.imu.begin(), outputs.imu.end());
+    recording.ticks.insert(recording.ticks.end(), outputs.wheel_ticks.begin(), outputs.wheel_ticks.end());
+    if (outputs.ring) {
+      for (const auto& image : outputs.ring->frame.images) recording.images.push_back(image.data);
+    }
+  }
+  return recording;
+}
+
+TEST(Determinism, SameSeedSameBytes) {
+  const Recording a = Record(42, "determinism_a");
+  const Recording b = Record(42, "determinism_b");
+  const Recording c = Record(43, "determinism_c");
+  ASSERT_EQ(a.images.size(), 20u);
+  ASSERT_EQ(a.images.size(), b.images.size());
+  for (size_t i = 0; i < a.images.size(); ++i) EXPECT_TRUE(a.images[i] == b.images[i]) << "image " << i;
+  ASSERT_EQ(a.imu.size(), b.imu.size());
+  ASSERT_GT(a.imu.size(), 80u);
+  for (size_t i = 0; i < a.imu.size(); ++i) {
+    EXPECT_EQ(std::memcmp(&a.imu[i], &b.imu[i], sizeof(messages::ImuSample)), 0) << "IMU sample " << i;
+  }
+  for (size_t i = 0; i < a.ticks.size(); ++i) EXPECT_EQ(a.ticks[i].left, b.ticks[i].left);
+  // Another seed: different image noise and IMU noise.
+  EXPECT_FALSE(a.images[0] == c.images[0]);
+  EXPECT_NE(a.imu[0].angular_velocity.x(), c.imu[0].angular_velocity.x());
+}
+
+}  // namespace
+}  // namespace trimbot::sim

@@ -1,0 +1,207 @@
+// The simulated robot in MuJoCo: drive kinematics against the analytic arc, IMU in the world,
+// the MuJoCo model against the URDF, contacts with garden objects.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim_test_support.h"
+#include "trimbot/sim/base_controller.h"
+#include "trimbot/sim/world.h"
+
+namespace trimbot::sim {
+namespace {
+
+using testing::TestConfig;
+using testing::TestLawn;
+
+struct PlanarPose {
+  double x = 0, y = 0, yaw = 0;
+};
+
+PlanarPose Planar(const Eigen::Isometry3d& pose) {
+  return {pose.translation().x(), pose.translation().y(),
+          std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))};
+}
+
+// Drives a constant command and integrates the unicycle model with the same rate-limited
+// velocities the base controller produces (exact arc per step).
+void DriveAndCompareWithArc(double linear, double angular, double seconds, double tolerance) {
+  SimulatorConfig config = TestConfig(TestLawn(), "arc");
+  config.start = {0.0, -1.0, 0.3};
+  Simulator simulator(config);
+  BaseController reference(simulator.robot().drive(), simulator.parameters().drive);
+  simulator.SetBaseCommand({linear, angular});
+  reference.SetCommand({linear, angular});
+  PlanarPose expected = {config.start.x, config.start.y, config.start.yaw};
+  StepOutputs outputs;
+  double worst = 0.0, worst_heading = 0.0;
+  while (simulator.time() < seconds) {
+    outputs.Clear();
+    simulator.Step(&outputs);
+    reference.Update(simulator.timestep());
+    const double v = reference.linear(), w = reference.angular(), dt = simulator.timestep();
+    if (std::abs(w) > 1e-9) {
+      expected.x += v / w * (std::sin(expected.yaw + w * dt) - std::sin(expected.yaw));
+      expected.y -= v / w * (std::cos(expected.yaw + w * dt) - std::cos(expected.yaw));
+    } else {
+      expected.x += v * dt * std::cos(expected.yaw);
+      expected.y += v * dt * std::sin(expected.yaw);
+    }
+    expected.yaw += w * dt;
+    const PlanarPose actual = Planar(simulator.ground_truth().T_map_base);
+    worst = std::max(worst, std::hypot(actual.x - expected.x, actual.y - expected.y));
+    worst_heading = std::max(worst_heading, std::abs(std::remainder(actual.yaw - expected.yaw, 2 * M_PI)));
+  }
+  const PlanarPose end = Planar(simulator.ground_truth().T_map_base);
+  EXPECT_LT(worst, tolerance) << "end at " << end.x << ", " << end.y << " expected " << expected.x << ", " << expected.y;
+  EXPECT_LT(worst_heading, 0.02);
+  // The robot stays on the ground and upright.
+  EXPECT_NEAR(simulator.ground_truth().T_map_base.translation().z(), 0.0, 0.01);
+  EXPECT_GT(simulator.ground_truth().T_map_base.linear()(2, 2), 0.999);
+}
+
+TEST(BaseKinematics, StraightDriveFollowsTheCommand) { DriveAndCompareWithArc(0.25, 0.0, 12.0, 0.02); }
+
+TEST(BaseKinematics, ArcFollowsTheAnalyticCircle) {
+  // A quarter turn and more at 25 cm/s on a 1.25 m radius.
+  DriveAndCompareWithArc(0.25, 0.2, 12.0, 0.03);
+}
+
+TEST(BaseKinematics, TurnOnTheSpot) { DriveAndCompareWithArc(0.0, 0.5, 6.0, 0.02); }
+
+TEST(SimulatedImu, ReadsGravityAtRestAndTheYawRateInATurn) {
+  Simulator simulator(TestConfig(TestLawn(), "imu"));
+  StepOutputs outputs;
+  std::vector<messages::ImuSample> samples;
+  while (simulator.time() < 3.0) {
+    simulator.Step(&outputs);
+  }
+  // Discard the first second (the robot settles on its wheels).
+  for (const auto& s : outputs.imu) {
+    if (s.stamp > 1.0) samples.push_back(s);
+  }
+  ASSERT_GT(samples.size(), 350u);  // 200 Hz
+  Eigen::Vector3d mean_a = Eigen::Vector3d::Zero(), mean_g = Eigen::Vector3d::Zero();
+  for (const auto& s : samples) {
+    mean_a += s.linear_acceleration / samples.size();
+    mean_g += s.angular_velocity / samples.size();
+  }
+  const GroundTruth truth = simulator.ground_truth();
+  EXPECT_LT((mean_a - truth.accelerometer_bias - Eigen::Vector3d(0, 0, 9.81)).norm(), 0.02);
+  EXPECT_LT((mean_g - truth.gyroscope_bias).norm(), 0.002);
+
+  outputs.Clear();
+  simulator.SetBaseCommand({0.0, 0.4});
+  while (simulator.time() < 8.0) simulator.Step(&outputs);
+  double yaw_rate = 0.0;
+  int n = 0;
+  for (const auto& s : outputs.imu) {
+    if (s.stamp > 6.0) {
+      yaw_rate += s.angular_velocity.z() - simulator.ground_truth().gyroscope_bias.z();
+      ++n;
+    }
+  }
+  EXPECT_NEAR(yaw_rate / n, 0.4, 0.01);
+}
+
+TEST(WheelEncoders, OdometryOnGrassOverestimatesByTheSlip) {
+  SimulatorConfig config = TestConfig(TestLawn(), "slip");
+  config.start = {-4.0, -1.0, 0.0};
+  Simulator simulator(config);
+  simulator.SetBaseCommand({0.25, 0.0});
+  StepOutputs outputs;
+  while (simulator.time() < 20.0) simulator.Step(&outputs);
+  ASSERT_GE(outputs.wheel_ticks.size(), 999u);  // 50 Hz
+  const auto& first = outputs.wheel_ticks.front();
+  const auto& last = outputs.wheel_ticks.back();
+  const double radians_per_tick = 2 * M_PI / simulator.parameters().wheel_encoders.ticks_per_revolution;
+  const double measured = simulator.robot().drive().LinearFromWheels(
+      {(last.left - first.left) * radians_per_tick, (last.right - first.right) * radians_per_tick});
+  const double travelled = simulator.ground_truth().T_map_base.translation().x() - config.start.x;
+  EXPECT_GT(travelled, 4.5);
+  // Grass slip: 3% on average; over 20 s the Gauss-Markov part (2 s correlation) averages down.
+  EXPECT_NEAR(measured / travelled - 1.0, garden::PropertiesOf(garden::Surface::kGrass).slip.mean, 0.012);
+}
+
+TEST(MujocoModel, AgreesWithTheUrdf) {
+  SimulatorConfig config = TestConfig(TestLawn(), "agree");
+  config.start = {1.0, 2.0, 0.7};
+  Simulator simulator(config);
+  World& world = simulator.world();
+  const mjModel* m = world.model();
+  mjData* d = world.data();
+  // Compare at the zero joint configuration (the arm starts at home: reset it first).
+  for (const auto& joint : world.arm()) d->qpos[joint.qpos] = 0.0;
+  mj_forward(m, d);
+  const Eigen::Isometry3d T_map_base = simulator.ground_truth().T_map_base;
+  const auto& urdf = simulator.robot().urdf();
+  int bodies = 0, joints = 0;
+  for (const auto& [name, link] : urdf.links_) {
+    const int body = mj_name2id(m, mjOBJ_BODY, name.c_str());
+    const int site = mj_name2id(m, mjOBJ_SITE, name.c_str());
+    if (name.find("_optical_frame") != std::string::npos) continue;  // cameras, checked below
+    ASSERT_TRUE(body >= 0 || site >= 0) << "link " << name << " has no MuJoCo body or site";
+    const mjtNum* pos = body >= 0 ? d->xpos + 3 * body : d->site_xpos + 3 * site;
+    const mjtNum* mat = body >= 0 ? d->xmat + 9 * body : d->site_xmat + 9 * site;
+    const Eigen::Isometry3d expected = T_map_base * simulator.robot().FramePose(name);
+    Eigen::Matrix3d rotation;
+    rotation << mat[0], mat[1], mat[2], mat[3], mat[4], mat[5], mat[6], mat[7], mat[8];
+    EXPECT_LT((Eigen::Vector3d(pos[0], pos[1], pos[2]) - expected.translation()).norm(), 1e-6) << name;
+    EXPECT_LT(Eigen::AngleAxisd(rotation.transpose() * expected.linear()).angle(), 1e-6) << name;
+    bodies += body >= 0;
+  }
+  for (const auto& [name, joint] : urdf.joints_) {
+    if (joint->type == urdf::Joint::FIXED) continue;
+    const int id = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    ASSERT_GE(id, 0) << "joint " << name;
+    EXPECT_EQ(m->jnt_type[id], mjJNT_HINGE) << name;
+    // The joint axis in the world matches the URDF axis carried by the child frame.
+    const Eigen::Isometry3d child = T_map_base * simulator.robot().FramePose(joint->child_link_name);
+    const Eigen::Vector3d axis = child.linear() * Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
+    EXPECT_LT((Eigen::Vector3d(d->xaxis[3 * id], d->xaxis[3 * id + 1], d->xaxis[3 * id + 2]) - axis).norm(), 1e-6) << name;
+    if (joint->type == urdf::Joint::REVOLUTE) {
+      EXPECT_NEAR(m->jnt_range[2 * id], joint->limits->lower, 1e-9) << name;
+      EXPECT_NEAR(m->jnt_range[2 * id + 1], joint->limits->upper, 1e-9) << name;
+    }
+    ++joints;
+  }
+  EXPECT_EQ(joints, 9);  // 2 wheels, 6 arm joints, cutter
+  EXPECT_GE(bodies, 11);
+  // Cameras: MuJoCo camera i sits at the calibrated optical frame (looking along -z, y up).
+  for (int i = 0; i < simulator.rig().size(); ++i) {
+    const int id = world.camera_id(i);
+    const Eigen::Isometry3d expected = T_map_base * simulator.robot().FramePose(robot::RobotFrames::CameraOptical(i));
+    const Eigen::Vector3d position(d->cam_xpos[3 * id], d->cam_xpos[3 * id + 1], d->cam_xpos[3 * id + 2]);
+    const Eigen::Vector3d looking(-d->cam_xmat[9 * id + 2], -d->cam_xmat[9 * id + 5], -d->cam_xmat[9 * id + 8]);
+    const Eigen::Vector3d down(-d->cam_xmat[9 * id + 1], -d->cam_xmat[9 * id + 4], -d->cam_xmat[9 * id + 7]);
+    EXPECT_LT((position - expected.translation()).norm(), 1e-6) << "cam" << i;
+    EXPECT_LT((looking - expected.linear().col(2)).norm(), 1e-6) << "cam" << i;
+    EXPECT_LT((down - expected.linear().col(1)).norm(), 1e-6) << "cam" << i;
+  }
+  // Total mass from the URDF inertials.
+  double urdf_mass = 0.0;
+  for (const auto& [name, link] : urdf.links_) urdf_mass += link->inertial ? link->inertial->mass : 0.0;
+  double mujoco_mass = 0.0;
+  for (int b = 1; b < m->nbody; ++b) mujoco_mass += m->body_mass[b];
+  EXPECT_NEAR(mujoco_mass, urdf_mass, 1e-6);
+}
+
+TEST(Contacts, DrivingIntoTheHedgeIsReported) {
+  SimulatorConfig config = TestConfig(TestLawn(), "hedge");
+  config.start = {6.8, 0.0, 0.0};  // hedge face at x = 8.2, the chassis front 0.58 m ahead
+  Simulator simulator(config);
+  simulator.SetBaseCommand({0.3, 0.0});
+  StepOutputs outputs;
+  std::vector<ObstacleContact> contacts;
+  while (simulator.time() < 8.0 && contacts.empty()) {
+    outputs.Clear();
+    simulator.Step(&outputs);
+    contacts = simulator.ObstacleContacts();
+  }
+  ASSERT_FALSE(contacts.empty());
+  EXPECT_EQ(contacts.front().object_class, garden::ObjectClass::kHedge);
+  EXPECT_NEAR(simulator.ground_truth().T_map_base.translation().x(), 8.2 - 0.58, 0.05);
+}
+
+}  // namespace
+}  // namespace trimbot::sim
