@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "sim_test_support.h"
 #include "trimbot/sim/base_controller.h"
@@ -184,6 +185,27 @@ TEST(MujocoModel, AgreesWithTheUrdf) {
   double mujoco_mass = 0.0;
   for (int b = 1; b < m->nbody; ++b) mujoco_mass += m->body_mass[b];
   EXPECT_NEAR(mujoco_mass, urdf_mass, 1e-6);
+}
+
+TEST(Arm, ServosReachAPositionTargetAgainstGravity) {
+  Simulator simulator(TestConfig(TestLawn(), "arm"));
+  messages::ArmCommand command;
+  command.position = {0.5, 2.4, 1.2, 4.2, 1.44, 1.32};
+  simulator.SetArmCommand(command);
+  StepOutputs outputs;
+  while (simulator.time() < 4.0) {
+    outputs.Clear();
+    simulator.Step(&outputs);
+  }
+  const GroundTruth truth = simulator.ground_truth();
+  for (size_t i = 0; i < command.position.size(); ++i) {
+    EXPECT_NEAR(truth.arm_position[i], command.position[i], 0.01) << "arm_joint_" << i + 1;
+  }
+  // The end effector is where the URDF puts it for these joint angles.
+  std::map<std::string, double> joints;
+  for (size_t i = 0; i < command.position.size(); ++i) joints[robot::RobotFrames::ArmJoint(static_cast<int>(i))] = truth.arm_position[i];
+  const Eigen::Vector3d expected = (truth.T_map_base * simulator.robot().FramePose("arm_end_effector", joints)).translation();
+  EXPECT_LT((truth.T_map_end_effector.translation() - expected).norm(), 0.01);
 }
 
 TEST(Contacts, DrivingIntoTheHedgeIsReported) {

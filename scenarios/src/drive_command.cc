@@ -60,7 +60,7 @@ int RunDrive(const DriveOptions& options) {
   config.seed = options.seed.value_or(plan.seed);
   config.start = plan.start;
   config.render_cameras = options.cameras;
-  config.render_ground_truth = true;
+  config.ground_truth_every_frames = plan.save_every_frames;
   config.resolution_scale = options.resolution_scale;
 
   const auto setup_start = Clock::now();

@@ -165,7 +165,8 @@ void Simulator::Step(StepOutputs* outputs) {
   if (impl_->step % impl_->encoder_steps == 0) outputs->wheel_ticks.push_back(impl_->encoders->Read(d->time));
 
   if (impl_->renderer && impl_->step % impl_->camera_steps == 0) {
-    outputs->ring = CaptureRing(config_.render_ground_truth);
+    const int every = config_.ground_truth_every_frames;
+    outputs->ring = CaptureRing(every > 0 && impl_->frame % every == 0);
   }
 }
 

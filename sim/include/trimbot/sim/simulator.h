@@ -35,7 +35,7 @@ struct SimulatorConfig {
   Pose2D start;
   double timestep = 0.0025;          // s
   bool render_cameras = true;
-  bool render_ground_truth = false;  // depth and label images with every ring frame
+  int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
   double resolution_scale = 1.0;     // 0.5 renders half-resolution images
 };
 
@@ -60,7 +60,7 @@ struct ObstacleContact {
 
 struct RingCapture {
   messages::RingFrame frame;                      // sensor output (noisy images)
-  std::vector<RenderedView> ground_truth;         // depth/labels when render_ground_truth
+  std::vector<RenderedView> ground_truth;         // depth/labels on ground-truth frames, else empty
   std::vector<Eigen::Isometry3d> T_map_camera;    // true optical-frame poses
 };
 

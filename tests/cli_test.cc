@@ -1,0 +1,84 @@
+// The trimbot CLI's drive: a short run writes its outputs and a summary that says what happened;
+// a broken plan is an input error naming the file.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "drive_command.h"
+#include "test_support.h"
+#include "trimbot/common/input_error.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(DriveCommand, ShortDriveWritesFramesLogsAndSummary) {
+  DriveOptions options;
+  options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.output_dir = testing::TempDir("cli_drive");
+  fs::remove_all(options.output_dir);
+  options.seconds = 3.0;  // 2 s standing, then 1 s driving at up to 25 cm/s
+  options.resolution_scale = 0.5;
+  options.quiet = true;
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  ASSERT_EQ(RunDrive(options), 0);
+
+  const std::string out = options.output_dir;
+  std::ifstream summary_file(out + "/summary.json");
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "completed");
+  EXPECT_EQ(summary["seed"], 1);
+  EXPECT_NEAR(summary["simulated_seconds"].get<double>(), 3.0, 0.01);
+  EXPECT_EQ(summary["ring_frames"], 15);
+  EXPECT_EQ(summary["obstacle_contact_steps"], 0);
+  // The robot moved forward about 0.19 m (1 s: 0.5 s ramp at 0.5 m/s^2, then 0.25 m/s).
+  EXPECT_NEAR(summary["path_end"][0].get<double>(), 0.19, 0.02);
+  EXPECT_LT(summary["wheel_odometry_end_error_m"].get<double>(), 0.02);
+  for (int i = 0; i < 10; ++i) {
+    const std::string cam = out + "/frames/000000/cam" + std::to_string(i);
+    EXPECT_TRUE(fs::exists(cam + ".png")) << cam;
+    EXPECT_TRUE(fs::exists(cam + "_depth.png")) << cam;
+    EXPECT_TRUE(fs::exists(cam + "_class.png")) << cam;
+  }
+  EXPECT_TRUE(fs::exists(out + "/frames/000010/cam9.png"));
+  EXPECT_FALSE(fs::exists(out + "/frames/000001"));  // every 10th frame only
+  // 200 Hz IMU over 3 s (+ header).
+  std::ifstream imu(out + "/sensors/imu.csv");
+  const auto lines = std::count(std::istreambuf_iterator<char>(imu), std::istreambuf_iterator<char>(), '\n');
+  EXPECT_EQ(lines, 601);
+  EXPECT_TRUE(fs::exists(out + "/ground_truth/base.tum"));
+  EXPECT_TRUE(fs::exists(out + "/world/world.xml"));
+}
+
+TEST(DriveCommand, BrokenPlanIsAnInputErrorNamingTheFile) {
+  const std::string plan = testing::WriteTempFile(
+      "broken_plan.yaml", "garden: test_lawn\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\nsegments:\n  - {duration: fast, linear: 0, angular: 0}\n");
+  DriveOptions options;
+  options.plan_path = plan;
+  options.output_dir = testing::TempDir("cli_broken");
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  try {
+    RunDrive(options);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), plan);
+    EXPECT_NE(std::string(e.what()).find("line 5: key 'segments[0].duration': expected a number"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(DriveCommand, UnknownGardenIsAnInputError) {
+  const std::string plan = testing::WriteTempFile(
+      "unknown_garden.yaml", "garden: versailles\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\nsegments:\n  - {duration: 1, linear: 0, angular: 0}\n");
+  DriveOptions options;
+  options.plan_path = plan;
+  options.output_dir = testing::TempDir("cli_unknown");
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  EXPECT_THROW(RunDrive(options), InputError);
+}
+
+}  // namespace
+}  // namespace trimbot::scenarios
