@@ -139,8 +139,14 @@ TEST_F(RenderedTargets, LabelsNameTheObjectsAndTheGround) {
   }
   EXPECT_GT(count[static_cast<int>(garden::ObjectClass::kGround)], 10000);
   EXPECT_GT(count[static_cast<int>(garden::ObjectClass::kObstacle)], 50000);
-  // The sky above the wall is "nothing"; no pixel carries an unknown class.
+  // No pixel carries an unknown class.
   for (const auto& [value, n] : count) EXPECT_LE(value, static_cast<int>(garden::ObjectClass::kRobot));
+  // A rear camera sees sky: "nothing" there, and no depth exactly where nothing was hit.
+  const cv::Mat& rear_classes = capture_->ground_truth[5].object_class;
+  const cv::Mat& rear_depth = capture_->ground_truth[5].depth;
+  const int sky = cv::countNonZero(rear_classes == 0);
+  EXPECT_GT(sky, 50000);
+  EXPECT_EQ(cv::countNonZero(rear_depth == 0.0f), sky);
 }
 
 // Same scenario and seed: the same bytes in images and IMU samples; another seed differs.

@@ -16,7 +16,7 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale) {
+sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4) {
   sim::SimulatorConfig config;
   config.urdf_path = options.paths.urdf();
   config.calibration_path = options.paths.nominal_calibration();
@@ -26,11 +26,12 @@ sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double sc
   config.seed = 7;
   config.render_cameras = cameras;
   config.resolution_scale = scale;
+  config.msaa_samples = msaa;
   return config;
 }
 
-nlohmann::json RenderCost(const BenchOptions& options, double scale) {
-  sim::Simulator simulator(Config(options, true, scale));
+nlohmann::json RenderCost(const BenchOptions& options, double scale, int msaa) {
+  sim::Simulator simulator(Config(options, true, scale, msaa));
   simulator.CaptureRing(false);  // warm-up: shader compilation, texture upload
   auto start = Clock::now();
   for (int i = 0; i < options.frames; ++i) simulator.CaptureRing(false);
@@ -46,8 +47,9 @@ nlohmann::json RenderCost(const BenchOptions& options, double scale) {
   out["ms_per_ring"] = ring_ms;
   out["ms_per_camera_with_depth_and_labels"] = ring_truth_ms / simulator.rig().size();
   out["ms_per_ring_with_depth_and_labels"] = ring_truth_ms;
-  std::printf("  %4dx%-4d  %7.1f ms/camera  %7.1f ms/ring  | with depth+labels %7.1f ms/camera %7.1f ms/ring\n",
-              out["width"].get<int>(), out["height"].get<int>(), ring_ms / simulator.rig().size(), ring_ms,
+  out["msaa_samples"] = msaa;
+  std::printf("  %4dx%-4d msaa %d  %7.1f ms/camera  %7.1f ms/ring  | with depth+labels %7.1f ms/camera %7.1f ms/ring\n",
+              out["width"].get<int>(), out["height"].get<int>(), msaa, ring_ms / simulator.rig().size(), ring_ms,
               ring_truth_ms / simulator.rig().size(), ring_truth_ms);
   return out;
 }
@@ -70,8 +72,10 @@ int RunBench(const BenchOptions& options) {
   nlohmann::json report;
   report["garden"] = options.garden;
   std::printf("rendering (%s, %d ring frames each, OSMesa/llvmpipe):\n", options.garden.c_str(), options.frames);
-  report["render_full_resolution"] = RenderCost(options, 1.0);
-  report["render_half_resolution"] = RenderCost(options, 0.5);
+  report["render_full_resolution"] = RenderCost(options, 1.0, 4);
+  report["render_half_resolution"] = RenderCost(options, 0.5, 4);
+  report["render_full_resolution_no_msaa"] = RenderCost(options, 1.0, 0);
+  report["render_half_resolution_no_msaa"] = RenderCost(options, 0.5, 0);
 
   {
     sim::Simulator simulator(Config(options, false, 1.0));

@@ -62,6 +62,7 @@ int RunDrive(const DriveOptions& options) {
   config.render_cameras = options.cameras;
   config.ground_truth_every_frames = plan.save_every_frames;
   config.resolution_scale = options.resolution_scale;
+  config.msaa_samples = options.msaa_samples;
 
   const auto setup_start = Clock::now();
   sim::Simulator simulator(config);
@@ -190,6 +191,7 @@ int RunDrive(const DriveOptions& options) {
   summary["ring_frames"] = frames;
   summary["ring_frames_saved"] = saved_frames;
   summary["resolution_scale"] = options.resolution_scale;
+  summary["msaa_samples"] = options.msaa_samples;
   summary["ms_per_ring_frame"] = frames > 0 ? 1000.0 * render_seconds / frames : 0.0;
   summary["path_end"] = {final_truth.T_map_base.translation().x(), final_truth.T_map_base.translation().y()};
   summary["wheel_odometry_end_error_m"] = odometry_error;

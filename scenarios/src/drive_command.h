@@ -14,6 +14,7 @@ struct DriveOptions {
   std::optional<double> seconds;            // stop early
   std::string calibration_path;             // empty: the nominal calibration
   double resolution_scale = 1.0;
+  int msaa_samples = 4;
   bool cameras = true;
   bool quiet = false;
   ProjectPaths paths;

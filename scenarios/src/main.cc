@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   drive_cmd->add_option("--calibration", drive.calibration_path, "camera calibration (Kalibr camchain)");
   drive_cmd->add_option("--resolution-scale", drive.resolution_scale, "render at this fraction of 752x480")
       ->check(CLI::Range(0.1, 1.0));
+  drive_cmd->add_option("--msaa", drive.msaa_samples, "anti-aliasing samples (0: twice as fast, jagged edges)")
+      ->check(CLI::Range(0, 16));
   bool no_cameras = false;
   drive_cmd->add_flag("--no-cameras", no_cameras, "do not render the ring");
   drive_cmd->add_flag("--quiet", drive.quiet, "no progress display");

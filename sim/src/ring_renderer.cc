@@ -111,6 +111,13 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
 
 RenderedView RingRenderer::Render(int index, bool with_ground_truth) {
   const CameraSetup& camera = cameras_.at(static_cast<size_t>(index));
+  // Several renderers (simulators) may live in one process; each draws with its own context.
+  const mjModel* m = world_.model();
+  if (OSMesaGetCurrentContext() != gl_->context &&
+      !OSMesaMakeCurrent(gl_->context, gl_->buffer.data(), GL_UNSIGNED_BYTE, m->vis.global.offwidth,
+                         m->vis.global.offheight)) {
+    throw std::runtime_error("OSMesa: cannot make the context current");
+  }
   const int camera_id = world_.camera_id(index);
   RenderedView view;
   cv::Mat rgb, depth;
@@ -140,6 +147,8 @@ RenderedView RingRenderer::Render(int index, bool with_ground_truth) {
   }
   cv::remap(object_class, view.object_class, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::remap(object_id, view.object_id, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  // The skybox is drawn as far geometry; where nothing was hit, depth is "none" (0).
+  view.depth.setTo(0.0f, view.object_class == 0);
   return view;
 }
 

@@ -68,6 +68,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   options.timestep = config.timestep;
   options.start = config.start;
   options.seed = config.seed;
+  options.msaa_samples = config.msaa_samples;
   spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);
   impl_->world = std::make_unique<World>(spec_);
 

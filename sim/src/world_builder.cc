@@ -277,7 +277,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
       << "  <statistic center=\"" << Num(garden.centre.x()) << " " << Num(garden.centre.y()) << " 0\" extent=\"1\"/>\n"
       << "  <visual>\n"
       << "    <global offwidth=\"" << max_render_w << "\" offheight=\"" << max_render_h << "\"/>\n"
-      << "    <quality shadowsize=\"4096\" offsamples=\"4\"/>\n"
+      << "    <quality shadowsize=\"2048\" offsamples=\"" << options.msaa_samples << "\"/>\n"
       << "    <map znear=\"0.02\" zfar=\"80\" shadowclip=\"" << Num(shadow_extent) << "\"/>\n"
       << "    <headlight active=\"0\" ambient=\"0 0 0\" diffuse=\"0 0 0\" specular=\"0 0 0\"/>\n"
       << "  </visual>\n"
