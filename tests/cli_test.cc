@@ -53,31 +53,36 @@ TEST(DriveCommand, ShortDriveWritesFramesLogsAndSummary) {
   EXPECT_TRUE(fs::exists(out + "/world/world.xml"));
 }
 
-TEST(DriveCommand, BrokenPlanIsAnInputErrorNamingTheFile) {
-  const std::string plan = testing::WriteTempFile(
-      "broken_plan.yaml", "garden: test_lawn\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\nsegments:\n  - {duration: fast, linear: 0, angular: 0}\n");
+// Options for a drive of a plan written to a temporary file.
+DriveOptions PlanFile(const std::string& name, const std::string& garden, const std::string& duration) {
   DriveOptions options;
-  options.plan_path = plan;
-  options.output_dir = testing::TempDir("cli_broken");
+  options.plan_path = testing::WriteTempFile(name, "garden: " + garden + "\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\n" +
+                                                       "segments:\n  - {duration: " + duration + ", linear: 0, angular: 0}\n");
+  options.output_dir = testing::TempDir(name);
   options.paths = {TRIMBOT_SOURCE_DIR};
+  return options;
+}
+
+TEST(DriveCommand, BrokenPlanIsAnInputErrorNamingTheFile) {
+  const DriveOptions options = PlanFile("broken_plan.yaml", "test_lawn", "fast");
   try {
     RunDrive(options);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), plan);
+    EXPECT_EQ(e.file(), options.plan_path);
     EXPECT_NE(std::string(e.what()).find("line 5: key 'segments[0].duration': expected a number"), std::string::npos)
         << e.what();
   }
 }
 
 TEST(DriveCommand, UnknownGardenIsAnInputError) {
-  const std::string plan = testing::WriteTempFile(
-      "unknown_garden.yaml", "garden: versailles\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\nsegments:\n  - {duration: 1, linear: 0, angular: 0}\n");
-  DriveOptions options;
-  options.plan_path = plan;
-  options.output_dir = testing::TempDir("cli_unknown");
-  options.paths = {TRIMBOT_SOURCE_DIR};
-  EXPECT_THROW(RunDrive(options), InputError);
+  const DriveOptions options = PlanFile("unknown_garden.yaml", "versailles", "1");
+  try {
+    RunDrive(options);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown garden 'versailles'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

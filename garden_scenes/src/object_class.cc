@@ -25,35 +25,28 @@ constexpr std::array<std::pair<Surface, const char*>, 3> kSurfaceNames = {{
     {Surface::kPavement, "pavement"},
 }};
 
+template <typename Enum, size_t N>
+std::string NameIn(const std::array<std::pair<Enum, const char*>, N>& table, Enum value) {
+  for (const auto& [entry, name] : table) {
+    if (entry == value) return name;
+  }
+  return "unknown";
+}
+
+template <typename Enum, size_t N>
+std::optional<Enum> ValueIn(const std::array<std::pair<Enum, const char*>, N>& table, const std::string& name) {
+  for (const auto& [entry, text] : table) {
+    if (name == text) return entry;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
-std::string ToString(ObjectClass c) {
-  for (const auto& [value, name] : kClassNames) {
-    if (value == c) return name;
-  }
-  return "unknown";
-}
-
-std::optional<ObjectClass> ObjectClassFromString(const std::string& name) {
-  for (const auto& [value, text] : kClassNames) {
-    if (name == text) return value;
-  }
-  return std::nullopt;
-}
-
-std::string ToString(Surface s) {
-  for (const auto& [value, name] : kSurfaceNames) {
-    if (value == s) return name;
-  }
-  return "unknown";
-}
-
-std::optional<Surface> SurfaceFromString(const std::string& name) {
-  for (const auto& [value, text] : kSurfaceNames) {
-    if (name == text) return value;
-  }
-  return std::nullopt;
-}
+std::string ToString(ObjectClass c) { return NameIn(kClassNames, c); }
+std::optional<ObjectClass> ObjectClassFromString(const std::string& name) { return ValueIn(kClassNames, name); }
+std::string ToString(Surface s) { return NameIn(kSurfaceNames, s); }
+std::optional<Surface> SurfaceFromString(const std::string& name) { return ValueIn(kSurfaceNames, name); }
 
 SurfaceProperties PropertiesOf(Surface s) {
   // Slip figures are typical of small wheeled robots: a few percent on grass, more on loose gravel.
