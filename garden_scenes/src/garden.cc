@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <set>
 
 #include "trimbot/common/input_error.h"
@@ -30,24 +32,34 @@ Garden Garden::Load(const std::string& path) {
   const auto size = root.Doubles("size", 2);
   garden.size = {size[0], size[1]};
   if (!(garden.size.x() > 0 && garden.size.y() > 0)) root.Fail("size", "must be positive");
+  root.Has("description");  // free text for people
   if (root.Has("centre")) {
     const auto centre = root.Doubles("centre", 2);
     garden.centre = {centre[0], centre[1]};
   }
   const std::string ground = root.String("ground");
   const auto surface = SurfaceFromString(ground);
-  if (!surface) root.Fail("ground", "unknown surface '" + ground + "' (grass, gravel, pavement)");
+  if (!surface) root.Fail("ground", "unknown surface '" + ground + "' (grass, gravel, pavement, soil)");
   garden.ground = *surface;
 
-  if (root.Has("sun")) {
-    const YamlMap sun = root.Map("sun");
-    garden.sun.azimuth = sun.Double("azimuth_deg", garden.sun.azimuth / kDegToRad) * kDegToRad;
-    garden.sun.elevation = sun.Double("elevation_deg", garden.sun.elevation / kDegToRad) * kDegToRad;
-    garden.sun.intensity = sun.Double("intensity", garden.sun.intensity);
-    if (sun.Has("colour")) garden.sun.colour = sun.Vector3("colour");
-    garden.sun.shadows = sun.Bool("shadows", garden.sun.shadows);
-    if (garden.sun.elevation <= 0.0 || garden.sun.elevation > M_PI / 2) sun.Fail("elevation_deg", "must be in (0, 90]");
-    sun.RejectUnknownKeys();
+  garden.latitude = root.Double("latitude_deg", garden.latitude / kDegToRad) * kDegToRad;
+  garden.north = root.Double("north_deg", garden.north / kDegToRad) * kDegToRad;
+  if (root.Has("paths")) {
+    for (const YamlMap& item : root.MapList("paths")) {
+      GroundPatch patch;
+      const std::string surface_name = item.String("surface");
+      const auto surface = SurfaceFromString(surface_name);
+      if (!surface) item.Fail("surface", "unknown surface '" + surface_name + "' (grass, gravel, pavement, soil)");
+      patch.surface = *surface;
+      const auto centre = item.Doubles("centre", 2);
+      const auto size = item.Doubles("size", 2);
+      patch.centre = {centre[0], centre[1]};
+      patch.size = {size[0], size[1]};
+      if (!(patch.size.minCoeff() > 0.0)) item.Fail("size", "must be positive");
+      patch.yaw = item.Double("yaw_deg", 0.0) * kDegToRad;
+      item.RejectUnknownKeys();
+      garden.paths.push_back(patch);
+    }
   }
 
   std::set<int> ids;
@@ -78,6 +90,39 @@ Garden Garden::Load(const std::string& path) {
   }
   root.RejectUnknownKeys();
   return garden;
+}
+
+bool IsFoliage(ObjectClass c) {
+  return c == ObjectClass::kTopiary || c == ObjectClass::kRose || c == ObjectClass::kHedge || c == ObjectClass::kTree;
+}
+
+std::string Garden::ToYaml() const {
+  std::ostringstream out;
+  out << std::setprecision(6);
+  auto shape_name = [](Shape shape) {
+    return shape == Shape::kBox ? "box" : shape == Shape::kCylinder ? "cylinder" : "ellipsoid";
+  };
+  out << "name: " << name << "\n"
+      << "size: [" << size.x() << ", " << size.y() << "]\n"
+      << "centre: [" << centre.x() << ", " << centre.y() << "]\n"
+      << "ground: " << ToString(ground) << "\n"
+      << "latitude_deg: " << latitude / kDegToRad << "\n"
+      << "north_deg: " << north / kDegToRad << "\n"
+      << "paths:" << (paths.empty() ? " []" : "") << "\n";
+  for (const auto& p : paths) {
+    out << "  - {surface: " << ToString(p.surface) << ", centre: [" << p.centre.x() << ", " << p.centre.y()
+        << "], size: [" << p.size.x() << ", " << p.size.y() << "], yaw_deg: " << p.yaw / kDegToRad << "}\n";
+  }
+  out << "objects:" << (objects.empty() ? " []" : "") << "\n";
+  for (const auto& o : objects) {
+    out << "  - {id: " << o.id << ", class: " << ToString(o.object_class) << ", shape: " << shape_name(o.shape)
+        << ", size: [" << o.size.x() << ", " << o.size.y() << ", " << o.size.z() << "], position: ["
+        << o.position.x() << ", " << o.position.y() << "]";
+    if (o.base_height != 0.0) out << ", base_height: " << o.base_height;
+    if (o.yaw != 0.0) out << ", yaw_deg: " << o.yaw / kDegToRad;
+    out << "}\n";
+  }
+  return out.str();
 }
 
 std::string Garden::Resolve(const std::string& name_or_path, const std::string& gardens_dir) {

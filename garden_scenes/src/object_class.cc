@@ -19,10 +19,11 @@ constexpr std::array<std::pair<ObjectClass, const char*>, 10> kClassNames = {{
     {ObjectClass::kRobot, "robot"},
 }};
 
-constexpr std::array<std::pair<Surface, const char*>, 3> kSurfaceNames = {{
+constexpr std::array<std::pair<Surface, const char*>, 4> kSurfaceNames = {{
     {Surface::kGrass, "grass"},
     {Surface::kGravel, "gravel"},
     {Surface::kPavement, "pavement"},
+    {Surface::kSoil, "soil"},
 }};
 
 template <typename Enum, size_t N>
@@ -57,6 +58,8 @@ SurfaceProperties PropertiesOf(Surface s) {
       return {0.7, {0.05, 0.025, 1.0}};
     case Surface::kPavement:
       return {1.0, {0.005, 0.003, 5.0}};
+    case Surface::kSoil:
+      return {0.6, {0.06, 0.03, 1.0}};
   }
   return {};
 }

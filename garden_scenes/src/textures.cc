@@ -100,6 +100,22 @@ cv::Mat Pavement(cv::RNG& rng, int size) {
   return image;
 }
 
+cv::Mat Soil(cv::RNG& rng, int size) {
+  // Bark mulch: dark soil with scattered chips of lighter bark.
+  cv::Mat field = FractalNoise(rng, size, {size / 12.0, 2.0}, {0.6, 0.8});
+  cv::Mat image = Tint(field, {30, 45, 65}, {8, 12, 16});
+  const int chips = size * size / 50;
+  for (int i = 0; i < chips; ++i) {
+    const cv::Point2f p(rng.uniform(0.f, static_cast<float>(size)), rng.uniform(0.f, static_cast<float>(size)));
+    const cv::Size axes(rng.uniform(3, 9), rng.uniform(1, 4));
+    const double shade = rng.uniform(0.6, 1.4);
+    const cv::Scalar colour(45 * shade, 75 * shade, 110 * shade);
+    const double angle = rng.uniform(0.0, 180.0);
+    DrawWrapped(image, p, [&](cv::Point2f q) { cv::ellipse(image, q, axes, angle, 0, 360, colour, -1, cv::LINE_AA); });
+  }
+  return image;
+}
+
 cv::Mat Leaves(cv::RNG& rng, int size, const cv::Vec3f& leaf_bgr, int leaf_px, int flowers) {
   cv::Mat field = FractalNoise(rng, size, {size / 16.0, 3.0}, {1.0, 0.5});
   cv::Mat image = Tint(field, {20, 45, 25}, {8, 14, 8});  // dark gaps between leaves
@@ -159,6 +175,7 @@ std::string ToString(Material m) {
     case Material::kGrass: return "grass";
     case Material::kGravel: return "gravel";
     case Material::kPavement: return "pavement";
+    case Material::kSoil: return "soil";
     case Material::kFoliage: return "foliage";
     case Material::kRoseFoliage: return "rose_foliage";
     case Material::kTreeFoliage: return "tree_foliage";
@@ -174,6 +191,7 @@ Material GroundMaterial(Surface s) {
     case Surface::kGrass: return Material::kGrass;
     case Surface::kGravel: return Material::kGravel;
     case Surface::kPavement: return Material::kPavement;
+    case Surface::kSoil: return Material::kSoil;
   }
   return Material::kGrass;
 }
@@ -193,7 +211,8 @@ Material MaterialOf(ObjectClass c) {
 double TileSize(Material m) {
   switch (m) {
     case Material::kGrass:
-    case Material::kGravel: return 4.0;
+    case Material::kGravel:
+    case Material::kSoil: return 4.0;
     case Material::kPavement: return 2.0;
     default: return 1.0;
   }
@@ -205,6 +224,7 @@ cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
     case Material::kGrass: return Grass(rng, size_px);
     case Material::kGravel: return Gravel(rng, size_px);
     case Material::kPavement: return Pavement(rng, size_px);
+    case Material::kSoil: return Soil(rng, size_px);
     case Material::kFoliage: return Leaves(rng, size_px, {30, 110, 45}, 14, 0);
     case Material::kRoseFoliage: return Leaves(rng, size_px, {35, 100, 55}, 18, size_px * size_px / 4000);
     case Material::kTreeFoliage: return Leaves(rng, size_px, {40, 140, 80}, 20, 0);

@@ -59,6 +59,7 @@ int RunDrive(const DriveOptions& options) {
   config.world_dir = out + "/world";
   config.seed = options.seed.value_or(plan.seed);
   config.start = plan.start;
+  config.conditions = plan.conditions;
   config.render_cameras = options.cameras;
   config.ground_truth_every_frames = plan.save_every_frames;
   config.resolution_scale = options.resolution_scale;
@@ -182,6 +183,10 @@ int RunDrive(const DriveOptions& options) {
   summary["plan"] = options.plan_path;
   summary["garden"] = config.garden_path;
   summary["seed"] = config.seed;
+  summary["conditions"] = {{"time_of_day", plan.conditions.time_of_day},
+                           {"day_of_year", plan.conditions.day_of_year},
+                           {"shadows", plan.conditions.shadows},
+                           {"growth", plan.conditions.growth}};
   summary["calibration"] = config.calibration_path;
   summary["simulated_seconds"] = simulator.time();
   summary["wall_seconds"] = wall;

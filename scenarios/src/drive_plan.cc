@@ -34,6 +34,7 @@ DrivePlan DrivePlan::Load(const std::string& path) {
   plan.start.y = start.Double("y");
   plan.start.yaw = start.Double("yaw_deg") * M_PI / 180.0;
   start.RejectUnknownKeys();
+  if (root.Has("conditions")) plan.conditions = garden::Conditions::FromYaml(root.Map("conditions"));
   plan.save_every_frames = root.Int("save_every_frames", 10);
   if (plan.save_every_frames < 1) root.Fail("save_every_frames", "must be at least 1");
   for (const YamlMap& item : root.MapList("segments")) {

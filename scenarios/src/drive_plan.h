@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "trimbot/garden/conditions.h"
 #include "trimbot/sim/world_builder.h"
 
 namespace trimbot::scenarios {
@@ -24,6 +25,7 @@ struct DrivePlan {
   std::string garden;
   std::uint64_t seed = 0;
   sim::Pose2D start;
+  garden::Conditions conditions;
   int save_every_frames = 10;
   std::vector<DriveSegment> segments;
 

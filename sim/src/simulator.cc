@@ -50,7 +50,7 @@ struct Simulator::Impl {
   long frame = 0;
   int imu_steps = 1, encoder_steps = 1, camera_steps = 1;
   double last_left_angle = 0.0, last_right_angle = 0.0;
-  garden::SlipModel ground_slip[3];
+  garden::SlipModel ground_slip[4];
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
@@ -68,6 +68,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   options.timestep = config.timestep;
   options.start = config.start;
   options.seed = config.seed;
+  options.conditions = config.conditions;
   options.msaa_samples = config.msaa_samples;
   spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);
   impl_->world = std::make_unique<World>(spec_);
@@ -80,7 +81,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->base = std::make_unique<BaseController>(robot_.drive(), parameters_.drive);
   impl_->imu = std::make_unique<ImuModel>(parameters_.imu, config.seed);
   impl_->encoders = std::make_unique<WheelEncoderModel>(parameters_.wheel_encoders.ticks_per_revolution, config.seed);
-  for (auto surface : {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement}) {
+  for (auto surface : {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement, garden::Surface::kSoil}) {
     impl_->ground_slip[static_cast<int>(surface)] = garden::PropertiesOf(surface).slip;
   }
 

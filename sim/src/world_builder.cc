@@ -10,6 +10,7 @@
 
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/garden/object_mesh.h"
 #include "trimbot/garden/textures.h"
 #include "trimbot/sim/render_pinhole.h"
 
@@ -208,60 +209,70 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     max_render_h = std::max(max_render_h, render.height);
   }
 
-  // Materials: one texture per material used by the garden.
-  std::set<garden::Material> materials = {garden::GroundMaterial(garden.ground)};
+  // Materials: one texture per material the garden uses. Meshes carry their own texture
+  // coordinates (in tiles); the lawn plane repeats its texture per metre instead.
+  const garden::Material lawn = garden::GroundMaterial(garden.ground);
+  std::set<garden::Material> materials = {lawn};
+  for (const auto& path : garden.paths) materials.insert(garden::GroundMaterial(path.surface));
   for (const auto& object : garden.objects) materials.insert(garden::MaterialOf(object.object_class));
   std::ostringstream assets;
   assets << "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.55 0.70 0.92\" "
             "rgb2=\"0.92 0.95 1.0\" width=\"256\" height=\"256\"/>\n";
   for (const auto material : materials) {
     const std::string name = garden::ToString(material);
-    const bool is_ground = material == garden::GroundMaterial(garden.ground);
-    const std::string path = WriteTexture(material, options, texture_dir);
-    const double repeat = 1.0 / garden::TileSize(material);
-    assets << "    <texture name=\"" << name << "\" type=\"" << (is_ground ? "2d" : "cube") << "\" file=\"" << path
+    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << WriteTexture(material, options, texture_dir)
            << "\"/>\n"
-           << "    <material name=\"" << name << "\" texture=\"" << name << "\" texuniform=\"true\" texrepeat=\""
-           << Num(repeat) << " " << Num(repeat) << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
+           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
   }
+  const double repeat = 1.0 / garden::TileSize(lawn);
+  assets << "    <material name=\"lawn\" texture=\"" << garden::ToString(lawn) << "\" texuniform=\"true\" texrepeat=\""
+         << Num(repeat) << " " << Num(repeat) << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
 
-  // Garden geometry: static geoms in the world body.
+  // Garden geometry: static geoms in the world body; objects and paths are meshes.
   std::ostringstream world;
   const double margin = 60.0;  // the lawn runs on past the garden so the horizon is not sky
   const garden::SurfaceProperties ground = garden::PropertiesOf(garden.ground);
   world << "    <geom name=\"garden/ground\" class=\"garden\" type=\"plane\" pos=\"" << Num(garden.centre.x()) << " "
         << Num(garden.centre.y()) << " 0\" size=\"" << Num(garden.size.x() / 2 + margin) << " "
-        << Num(garden.size.y() / 2 + margin) << " 0.1\" material=\"" << garden::ToString(garden::GroundMaterial(garden.ground))
-        << "\" friction=\"" << Num(ground.friction) << " 0.005 0.0001\"/>\n";
+        << Num(garden.size.y() / 2 + margin) << " 0.1\" material=\"lawn\" friction=\"" << Num(ground.friction)
+        << " 0.005 0.0001\"/>\n";
   spec.labels.push_back({"garden/ground", ObjectClass::kGround, garden::kGroundObjectId, true, garden.ground});
+  auto emit_mesh = [&](const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose,
+                       const std::string& material, const std::string& extra) {
+    assets << "    <mesh name=\"" << name << "\" vertex=\"";
+    for (const auto& v : mesh.vertices) assets << Num(v.x()) << ' ' << Num(v.y()) << ' ' << Num(v.z()) << ' ';
+    assets << "\" texcoord=\"";
+    for (const auto& t : mesh.texcoords) assets << Num(t.x()) << ' ' << Num(t.y()) << ' ';
+    assets << "\" face=\"";
+    for (const auto& f : mesh.faces) assets << f[0] << ' ' << f[1] << ' ' << f[2] << ' ';
+    assets << "\"/>\n";
+    Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+    iso.matrix() = pose;
+    world << "    <geom name=\"" << name << "\" class=\"garden\" type=\"mesh\" mesh=\"" << name << "\" "
+          << PoseAttributes(iso) << " material=\"" << material << "\"" << extra << "/>\n";
+  };
+  // Paths and beds: 4 mm slabs on the lawn, so the wheels touch (and slip on) their surface.
+  for (size_t i = 0; i < garden.paths.size(); ++i) {
+    const auto& path = garden.paths[i];
+    const garden::Material material = garden::GroundMaterial(path.surface);
+    const std::string name = "garden/path" + std::to_string(i) + "_" + garden::ToString(path.surface);
+    garden::GardenObject slab;
+    slab.position = path.centre;
+    slab.yaw = path.yaw;
+    emit_mesh(name, garden::BoxMesh({path.size.x(), path.size.y(), 0.004}, garden::TileSize(material)),
+              garden::ObjectPose(slab), garden::ToString(material),
+              " friction=\"" + Num(garden::PropertiesOf(path.surface).friction) + " 0.005 0.0001\"");
+    spec.labels.push_back({name, ObjectClass::kGround, garden::kGroundObjectId, true, path.surface});
+  }
   for (const auto& object : garden.objects) {
     const std::string name = "garden/" + std::to_string(object.id) + "_" + garden::ToString(object.object_class);
-    const Eigen::Vector3d half = object.size / 2.0;
-    std::string type, size;
-    switch (object.shape) {
-      case garden::Shape::kBox:
-        type = "box";
-        size = Vec(half);
-        break;
-      case garden::Shape::kEllipsoid:
-        type = "ellipsoid";
-        size = Vec(half);
-        break;
-      case garden::Shape::kCylinder:
-        // MuJoCo cylinders are round: the footprint is the larger of the two extents.
-        type = "cylinder";
-        size = Num(std::max(half.x(), half.y())) + " " + Num(half.z());
-        break;
-    }
-    world << "    <geom name=\"" << name << "\" class=\"garden\" type=\"" << type << "\" size=\"" << size
-          << "\" pos=\"" << Num(object.position.x()) << " " << Num(object.position.y()) << " "
-          << Num(object.base_height + half.z()) << "\" euler=\"0 0 " << Num(object.yaw) << "\" material=\""
-          << garden::ToString(garden::MaterialOf(object.object_class)) << "\"/>\n";
+    emit_mesh(name, garden::ObjectMesh(object, options.seed, options.conditions.growth), garden::ObjectPose(object),
+              garden::ToString(garden::MaterialOf(object.object_class)), "");
     spec.labels.push_back({name, object.object_class, static_cast<std::uint16_t>(object.id), false, garden.ground});
   }
 
-  // The sun: a directional light from (azimuth, elevation); a weak shadowless sky light fills.
-  const auto& sun = garden.sun;
+  // The sun: a directional light from (azimuth, elevation) of the run's conditions; the sky fills.
+  const garden::Sun sun = garden::SunFor(garden, options.conditions);
   const Eigen::Vector3d towards_sun(std::cos(sun.elevation) * std::cos(sun.azimuth),
                                     std::cos(sun.elevation) * std::sin(sun.azimuth), std::sin(sun.elevation));
   const Eigen::Vector3d sun_colour = sun.colour * sun.intensity;
@@ -297,7 +308,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
       << Vec(towards_sun * 20.0) << "\" dir=\"" << Vec(-towards_sun) << "\" diffuse=\"" << Vec(sun_colour)
       << "\" specular=\"0.1 0.1 0.1\"/>\n"
       << "    <light name=\"sky\" directional=\"true\" castshadow=\"false\" pos=\"0 0 20\" dir=\"0 0 -1\" "
-         "diffuse=\"0.15 0.16 0.18\" ambient=\"0.32 0.34 0.36\" specular=\"0 0 0\"/>\n"
+         "diffuse=\"0.15 0.16 0.18\" ambient=\"" << Vec(sun.ambient) << "\" specular=\"0 0 0\"/>\n"
       << world.str() << robot_body << "  </worldbody>\n"
       << "  <actuator>\n";
   for (const char* wheel : {RobotFrames::kLeftWheelJoint, RobotFrames::kRightWheelJoint}) {

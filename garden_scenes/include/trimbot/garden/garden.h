@@ -1,6 +1,7 @@
 #pragma once
-// A garden as data: ground, objects with their class and shape, and the sun. Gardens are YAML files
-// (garden_scenes/gardens/*.yaml); the simulator turns them into MuJoCo geometry.
+// A garden as data: lawn, paths and beds, and objects with their class and shape. Gardens are YAML
+// files (garden_scenes/gardens/*.yaml); the simulator turns them into MuJoCo geometry. What varies
+// from run to run (time of day, season) is in Conditions, not in the garden.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -14,19 +15,19 @@ enum class Shape { kBox, kCylinder, kEllipsoid };
 struct GardenObject {
   int id = 0;                                       // unique in the garden, 1..kMaxGardenObjectId
   ObjectClass object_class = ObjectClass::kObstacle;
-  Shape shape = Shape::kBox;
+  Shape shape = Shape::kBox;                        // the trimmed / nominal shape
   Eigen::Vector3d size = Eigen::Vector3d::Ones();   // m, full extent along x, y, z before yaw
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // m, centre of the footprint in the map frame
   double base_height = 0.0;                         // m above the ground where the object starts
   double yaw = 0.0;                                 // rad about z
 };
 
-struct Sun {
-  double azimuth = 2.4;      // rad, direction the light comes from, counter-clockwise from +x
-  double elevation = 0.8;    // rad above the horizon
-  double intensity = 0.8;    // diffuse, 0..1
-  Eigen::Vector3d colour = Eigen::Vector3d(1.0, 0.97, 0.9);
-  bool shadows = true;
+// A rectangle of another ground surface (a path or a bed), flush with the lawn.
+struct GroundPatch {
+  Surface surface = Surface::kGravel;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Vector2d size = Eigen::Vector2d::Ones();  // m, along the patch's own x and y
+  double yaw = 0.0;
 };
 
 struct Garden {
@@ -35,13 +36,18 @@ struct Garden {
   Eigen::Vector2d size = Eigen::Vector2d(10, 10);     // m, ground extent
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();   // m, ground centre in the map frame
   Surface ground = Surface::kGrass;
-  Sun sun;
+  double latitude = 52.0 * M_PI / 180.0;    // rad (Wageningen by default), for the sun's path
+  double north = M_PI / 2;                  // rad, direction of north in the map frame (from +x, CCW)
+  std::vector<GroundPatch> paths;
   std::vector<GardenObject> objects;
 
   // Throws InputError naming the file, line and key.
   static Garden Load(const std::string& path);
+  std::string ToYaml() const;
   // Finds garden_scenes/gardens/<name>.yaml, or takes a path to a .yaml file.
   static std::string Resolve(const std::string& name_or_path, const std::string& gardens_dir);
 };
+
+bool IsFoliage(ObjectClass c);
 
 }  // namespace trimbot::garden

@@ -24,7 +24,7 @@ std::string ToString(ObjectClass c);
 std::optional<ObjectClass> ObjectClassFromString(const std::string& name);
 
 // Ground surfaces differ in look, friction and wheel slip.
-enum class Surface { kGrass, kGravel, kPavement };
+enum class Surface { kGrass, kGravel, kPavement, kSoil };  // soil: bark-mulched beds
 std::string ToString(Surface s);
 std::optional<Surface> SurfaceFromString(const std::string& name);
 

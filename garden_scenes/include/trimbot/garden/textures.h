@@ -12,7 +12,7 @@
 
 namespace trimbot::garden {
 
-enum class Material { kGrass, kGravel, kPavement, kFoliage, kRoseFoliage, kTreeFoliage, kBark, kWood, kStone };
+enum class Material { kGrass, kGravel, kPavement, kSoil, kFoliage, kRoseFoliage, kTreeFoliage, kBark, kWood, kStone };
 
 std::string ToString(Material m);
 Material GroundMaterial(Surface s);

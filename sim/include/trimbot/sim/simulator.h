@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/messages/commands.h"
 #include "trimbot/messages/sensor_messages.h"
@@ -32,6 +33,7 @@ struct SimulatorConfig {
   std::string garden_path;
   std::string world_dir;             // where world.xml and its textures are written
   std::uint64_t seed = 0;
+  garden::Conditions conditions;     // time of day, shadows, growth
   Pose2D start;
   double timestep = 0.0025;          // s
   bool render_cameras = true;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
@@ -19,7 +20,8 @@ struct Pose2D {
 struct WorldOptions {
   double timestep = 0.002;        // s, fixed physics step
   Pose2D start;                   // base_link in the map frame
-  std::uint64_t seed = 0;         // seeds the garden textures
+  std::uint64_t seed = 0;         // seeds the garden's textures and foliage
+  garden::Conditions conditions;  // sun and growth
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;
   int msaa_samples = 4;           // multisample anti-aliasing; 0 renders twice as fast, with jagged edges

@@ -1,0 +1,34 @@
+#pragma once
+// Triangle meshes for garden objects, with texture coordinates in texture tiles. Hard objects
+// (fences, posts, trunks, obstacles, path slabs) are plain boxes and cylinders. Foliage is a
+// superellipsoid of the trimmed shape (ball, ellipsoid, rounded box, rounded cylinder) whose surface
+// is displaced by seeded noise: leaf clumps always, and irregular outgrowth that increases with the
+// season's growth. The trimmed shape is the target a trimming run cuts back to.
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "trimbot/garden/garden.h"
+
+namespace trimbot::garden {
+
+struct Mesh {
+  std::vector<Eigen::Vector3d> vertices;  // m, in the object frame (origin at the footprint centre, z up)
+  std::vector<Eigen::Vector2d> texcoords;  // per vertex, in texture tiles
+  std::vector<std::array<int, 3>> faces;   // counter-clockwise seen from outside
+
+  double Area() const;
+};
+
+// Box of the given full size, base on z = 0, textured `tile` metres per texture repeat.
+Mesh BoxMesh(const Eigen::Vector3d& size, double tile);
+// Mesh of a garden object in its own frame; `growth` in 0..1 (see Conditions).
+Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth);
+// Pose of the object frame in the map frame.
+Eigen::Matrix4d ObjectPose(const GardenObject& object);
+
+// Seeded smooth 3D value noise in -1..1 with unit feature size.
+double ValueNoise(std::uint64_t seed, const Eigen::Vector3d& p);
+
+}  // namespace trimbot::garden

@@ -1,0 +1,197 @@
+#include "trimbot/garden/object_mesh.h"
+
+#include <cmath>
+
+#include "trimbot/common/random.h"
+#include "trimbot/garden/conditions.h"
+#include "trimbot/garden/textures.h"
+
+namespace trimbot::garden {
+namespace {
+
+double Smooth(double t) { return t * t * (3.0 - 2.0 * t); }
+
+double LatticeValue(std::uint64_t seed, long x, long y, long z) {
+  std::uint64_t h = SplitMix64(seed ^ SplitMix64(static_cast<std::uint64_t>(x) * 0x9E3779B1ULL));
+  h = SplitMix64(h ^ static_cast<std::uint64_t>(y) * 0x85EBCA77ULL);
+  h = SplitMix64(h ^ static_cast<std::uint64_t>(z) * 0xC2B2AE3DULL);
+  return static_cast<double>(h >> 11) / static_cast<double>(1ULL << 53) * 2.0 - 1.0;
+}
+
+// Adds a quad (a, b, c, d counter-clockwise from outside) to a mesh.
+void Quad(Mesh& mesh, int a, int b, int c, int d) {
+  mesh.faces.push_back({a, b, c});
+  mesh.faces.push_back({a, c, d});
+}
+
+// Signed superellipsoid radius along a unit direction: horizontal exponent n, vertical m.
+double SuperRadius(const Eigen::Vector3d& d, const Eigen::Vector3d& half, double n, double m) {
+  const double horizontal =
+      std::pow(std::pow(std::abs(d.x() / half.x()), n) + std::pow(std::abs(d.y() / half.y()), n), m / n);
+  return 1.0 / std::pow(horizontal + std::pow(std::abs(d.z() / half.z()), m), 1.0 / m);
+}
+
+Mesh CylinderMesh(const Eigen::Vector3d& size, double tile) {
+  Mesh mesh;
+  constexpr int kSegments = 24;
+  const double rx = size.x() / 2, ry = size.y() / 2, h = size.z();
+  // Side: a column of vertices per segment, the seam duplicated for the texture.
+  for (int i = 0; i <= kSegments; ++i) {
+    const double a = 2.0 * M_PI * i / kSegments;
+    const double u = a * 0.5 * (rx + ry) / tile;
+    mesh.vertices.push_back({rx * std::cos(a), ry * std::sin(a), 0.0});
+    mesh.texcoords.push_back({u, 0.0});
+    mesh.vertices.push_back({rx * std::cos(a), ry * std::sin(a), h});
+    mesh.texcoords.push_back({u, h / tile});
+  }
+  for (int i = 0; i < kSegments; ++i) Quad(mesh, 2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
+  // Caps: fans around a centre vertex.
+  for (const double z : {0.0, h}) {
+    const int centre = static_cast<int>(mesh.vertices.size());
+    mesh.vertices.push_back({0.0, 0.0, z});
+    mesh.texcoords.push_back({0.0, 0.0});
+    for (int i = 0; i < kSegments; ++i) {
+      const double a = 2.0 * M_PI * i / kSegments;
+      mesh.vertices.push_back({rx * std::cos(a), ry * std::sin(a), z});
+      mesh.texcoords.push_back({rx * std::cos(a) / tile, ry * std::sin(a) / tile});
+    }
+    for (int i = 0; i < kSegments; ++i) {
+      const int a = centre + 1 + i, b = centre + 1 + (i + 1) % kSegments;
+      if (z == 0.0) {
+        mesh.faces.push_back({centre, b, a});
+      } else {
+        mesh.faces.push_back({centre, a, b});
+      }
+    }
+  }
+  return mesh;
+}
+
+// A superellipsoid of the object's shape (exponent 2 = round, larger = flatter sides), its surface
+// pushed out by leaf clumps (depth) and by growth.
+Mesh SuperellipsoidMesh(const GardenObject& object, std::uint64_t seed, double clump_depth, double growth) {
+  double n = 2.0, m = 2.0;
+  if (object.shape == Shape::kBox) n = m = 6.0;
+  if (object.shape == Shape::kCylinder) m = 6.0;
+  const Eigen::Vector3d half = object.size / 2.0;
+  // Leaf clumps: ~12 cm features on bushes, ~40 cm on tree crowns; outgrowth in ~30 cm shoots.
+  const double clump_scale = object.object_class == ObjectClass::kTree ? 0.4 : 0.12;
+  const std::uint64_t object_seed = StreamSeed(seed, "foliage/" + std::to_string(object.id));
+  const double tile = TileSize(MaterialOf(object.object_class));
+
+  Mesh mesh;
+  constexpr int kRings = 24, kSegments = 48;
+  for (int r = 0; r <= kRings; ++r) {
+    const double polar = M_PI * r / kRings;
+    for (int s = 0; s <= kSegments; ++s) {
+      const double azimuth = 2.0 * M_PI * s / kSegments;
+      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+      const Eigen::Vector3d surface = d * SuperRadius(d, half, n, m);
+      const double clumps = ValueNoise(object_seed, surface / clump_scale) * 0.7 +
+                            ValueNoise(object_seed + 1, surface / (clump_scale * 0.4)) * 0.3;
+      const double shoots = std::max(0.0, ValueNoise(object_seed + 2, surface / 0.3));  // outgrowth in patches
+      double outward = clump_depth * clumps + growth * kMaxGrowth * (0.4 + 1.2 * shoots);
+      // Never cut into the bottom (it sits on the ground or its stem).
+      Eigen::Vector3d p = surface + d * outward;
+      p.z() = std::max(p.z(), -half.z());
+      mesh.vertices.push_back(p + Eigen::Vector3d(0, 0, half.z()));
+      const double circumference = M_PI * (half.x() + half.y());
+      mesh.texcoords.push_back({azimuth / (2.0 * M_PI) * circumference / tile, polar / M_PI * 2.0 * half.z() / tile});
+    }
+  }
+  const int row = kSegments + 1;
+  for (int r = 0; r < kRings; ++r) {
+    for (int s = 0; s < kSegments; ++s) {
+      const int a = r * row + s, b = a + 1, c = a + row + 1, d = a + row;
+      // Rows at the poles collapse to a point: one triangle each there.
+      // (a, d, c, b) runs counter-clockwise seen from outside (polar x azimuth = outward).
+      if (r == 0) {
+        mesh.faces.push_back({a, d, c});
+      } else if (r == kRings - 1) {
+        mesh.faces.push_back({a, d, b});
+      } else {
+        Quad(mesh, a, d, c, b);
+      }
+    }
+  }
+  return mesh;
+}
+
+}  // namespace
+
+double ValueNoise(std::uint64_t seed, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d f = p.array().floor();
+  const long x = static_cast<long>(f.x()), y = static_cast<long>(f.y()), z = static_cast<long>(f.z());
+  const double tx = Smooth(p.x() - f.x()), ty = Smooth(p.y() - f.y()), tz = Smooth(p.z() - f.z());
+  double value = 0.0;
+  for (int dx = 0; dx <= 1; ++dx) {
+    for (int dy = 0; dy <= 1; ++dy) {
+      for (int dz = 0; dz <= 1; ++dz) {
+        const double w = (dx ? tx : 1 - tx) * (dy ? ty : 1 - ty) * (dz ? tz : 1 - tz);
+        value += w * LatticeValue(seed, x + dx, y + dy, z + dz);
+      }
+    }
+  }
+  return value;
+}
+
+double Mesh::Area() const {
+  double area = 0.0;
+  for (const auto& f : faces) {
+    area += 0.5 * (vertices[f[1]] - vertices[f[0]]).cross(vertices[f[2]] - vertices[f[0]]).norm();
+  }
+  return area;
+}
+
+Mesh BoxMesh(const Eigen::Vector3d& size, double tile) {
+  Mesh mesh;
+  const Eigen::Vector3d h = size / 2.0;
+  // Each face: an outward axis, and two in-face axes (u, v) forming a right-handed frame.
+  const std::array<std::array<Eigen::Vector3d, 3>, 6> faces = {{
+      {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()},
+      {-Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()},
+      {Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ()},
+      {-Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ()},
+      {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()},
+      {-Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX()},
+  }};
+  for (const auto& [normal, u, v] : faces) {
+    const int first = static_cast<int>(mesh.vertices.size());
+    for (const auto& [su, sv] : std::array<std::pair<double, double>, 4>{{{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}}) {
+      const Eigen::Vector3d p = normal.cwiseProduct(h) + su * u.cwiseProduct(h).cwiseAbs().norm() * u +
+                                sv * v.cwiseProduct(h).cwiseAbs().norm() * v;
+      mesh.vertices.push_back(p + Eigen::Vector3d(0, 0, h.z()));
+      mesh.texcoords.push_back({p.dot(u) / tile, p.dot(v) / tile});
+    }
+    Quad(mesh, first, first + 1, first + 2, first + 3);
+  }
+  return mesh;
+}
+
+Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth) {
+  if (IsFoliage(object.object_class)) {
+    return SuperellipsoidMesh(object, seed, object.object_class == ObjectClass::kTree ? 0.12 : 0.025, growth);
+  }
+  const double tile = TileSize(MaterialOf(object.object_class));
+  switch (object.shape) {
+    case Shape::kEllipsoid: return SuperellipsoidMesh(object, seed, 0.0, 0.0);
+    case Shape::kCylinder: return CylinderMesh(object.size, tile);
+    case Shape::kBox: return object.object_class == ObjectClass::kTrunk ? CylinderMesh(object.size, tile)
+                                                                         : BoxMesh(object.size, tile);
+  }
+  return {};
+}
+
+Eigen::Matrix4d ObjectPose(const GardenObject& object) {
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  pose(0, 0) = std::cos(object.yaw);
+  pose(0, 1) = -std::sin(object.yaw);
+  pose(1, 0) = std::sin(object.yaw);
+  pose(1, 1) = std::cos(object.yaw);
+  pose(0, 3) = object.position.x();
+  pose(1, 3) = object.position.y();
+  pose(2, 3) = object.base_height;
+  return pose;
+}
+
+}  // namespace trimbot::garden
