@@ -2,6 +2,7 @@
 // is metric, a stereo pair's disparity is f*B/Z, and the same seed gives the same bytes.
 #include <gtest/gtest.h>
 
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -192,6 +193,34 @@ TEST(Determinism, SameSeedSameBytes) {
   // Another seed: different image noise and IMU noise.
   EXPECT_FALSE(a.images[0] == c.images[0]);
   EXPECT_NE(a.imu[0].angular_velocity.x(), c.imu[0].angular_velocity.x());
+}
+
+}  // namespace
+}  // namespace trimbot::sim
+
+namespace trimbot::sim {
+namespace {
+
+// Real features for localization: SIFT finds a few hundred keypoints in a ring image of each kind
+// of ground (measured on the rendered, distorted, noisy image).
+TEST(GroundAppearance, SiftFindsFeaturesOnEveryGroundType) {
+  for (const char* surface : {"grass", "gravel", "pavement", "soil"}) {
+    const std::string garden = testing::WriteTempFile(
+        std::string("ground_") + surface + ".yaml",
+        std::string("name: ground_") + surface + "\nsize: [30, 30]\nground: " + surface + "\nobjects: []\n");
+    SimulatorConfig config = TestConfig(garden, std::string("sift_") + surface, true);
+    Simulator simulator(config);
+    const RingCapture capture = simulator.CaptureRing(false);
+    const auto& image = capture.frame.images[0];
+    const cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.data.data()));
+    cv::Mat grey;
+    cv::cvtColor(rgb, grey, cv::COLOR_RGB2GRAY);
+    std::vector<cv::KeyPoint> keypoints;
+    cv::SIFT::create()->detect(grey, keypoints);
+    // Only the ground half of the image has texture (the upper half is sky).
+    std::printf("SIFT: %zu keypoints on %s (cam0, 752x480)\n", keypoints.size(), surface);
+    EXPECT_GE(keypoints.size(), 300u) << surface;
+  }
 }
 
 }  // namespace

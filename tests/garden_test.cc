@@ -5,8 +5,15 @@
 
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/garden/object_mesh.h"
 #include "trimbot/garden/textures.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
 
 namespace trimbot::garden {
 namespace {
@@ -78,6 +85,167 @@ TEST(Textures, SameSeedSameImageOtherSeedOther) {
   cv::Scalar mean, stddev;
   cv::meanStdDev(a, mean, stddev);
   EXPECT_GT(stddev[1], 10.0);
+}
+
+// The Wageningen garden against its source map, read here independently of the importer.
+TEST(WageningenGarden, HasEveryObjectOfTheMapInItsPlace) {
+  const Garden garden = Garden::Load(SourcePath("garden_scenes/gardens/wageningen.yaml"));
+  std::map<int, const GardenObject*> by_id;
+  for (const auto& object : garden.objects) by_id[object.id] = &object;
+  std::ifstream csv(SourcePath("garden_scenes/data/wur31_objects.csv"));
+  std::string line;
+  int rows = 0;
+  const std::map<std::string, ObjectClass> classes = {
+      {"Hedge-Ivy", ObjectClass::kHedge},       {"Hedge-Box", ObjectClass::kHedge},
+      {"Topiary-Generic", ObjectClass::kTopiary}, {"Topiary-Ellipsoid", ObjectClass::kTopiary},
+      {"Rose-Generic", ObjectClass::kRose},     {"Obstacle-Tree", ObjectClass::kTree},
+      {"Obstacle-Trunk", ObjectClass::kTrunk},  {"Obstacle-Fence", ObjectClass::kFence},
+      {"Obstacle-Post", ObjectClass::kFence},   {"Obstacle-Generic", ObjectClass::kObstacle},
+      {"Robot-Vehicle", ObjectClass::kObstacle}, {"Background-Generic", ObjectClass::kObstacle}};
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("id,", 0) == 0) continue;
+    std::stringstream row(line);
+    std::vector<std::string> f;
+    for (std::string field; std::getline(row, field, ',');) f.push_back(field);
+    ASSERT_EQ(f.size(), 10u) << line;
+    ++rows;
+    const int id = std::stoi(f[0]);
+    ASSERT_TRUE(by_id.count(id)) << "object " << id << " (" << f[1] << ") missing";
+    const GardenObject& object = *by_id[id];
+    ASSERT_TRUE(classes.count(f[1])) << f[1];
+    EXPECT_EQ(object.object_class, classes.at(f[1])) << id;
+    EXPECT_NEAR(object.position.x(), std::stod(f[6]), 1e-6) << id;
+    EXPECT_NEAR(object.position.y(), std::stod(f[7]), 1e-6) << id;
+    EXPECT_NEAR(object.size.x(), std::stod(f[3]), 1e-6) << id;
+    EXPECT_NEAR(object.size.y(), std::stod(f[4]), 1e-6) << id;
+    EXPECT_NEAR(object.yaw, std::stod(f[9]) * M_PI / 180.0, 1e-9) << id;
+    // Tops stay where the map has them (ground at z = -1.48); low objects stand on the ground.
+    const double top = std::stod(f[8]) + 1.48 + std::stod(f[5]);
+    EXPECT_NEAR(object.base_height + object.size.z(), top, 1e-6) << id;
+    EXPECT_TRUE(object.base_height == 0.0 || object.object_class == ObjectClass::kTree) << id;
+  }
+  EXPECT_EQ(rows, 44);
+  EXPECT_EQ(garden.objects.size(), 44u);
+  EXPECT_EQ(garden.paths.size(), 3u);
+  EXPECT_EQ(garden.SurfaceAt({2.0, -1.75}), Surface::kGravel);
+  EXPECT_EQ(garden.SurfaceAt({10.7, 0.0}), Surface::kPavement);
+  EXPECT_EQ(garden.SurfaceAt({0.0, 1.5}), Surface::kGrass);
+}
+
+TEST(GardenGenerator, SameSeedSameGardenOtherSeedAnother) {
+  GeneratorParameters parameters;
+  parameters.seed = 7;
+  const Garden a = GenerateGarden(parameters);
+  const Garden b = GenerateGarden(parameters);
+  parameters.seed = 8;
+  const Garden c = GenerateGarden(parameters);
+  EXPECT_EQ(a.ToYaml(), b.ToYaml());
+  EXPECT_NE(a.ToYaml(), c.ToYaml());
+  // Every requested object is there: 8 topiary, 4 roses, 2 hedges, 2 trees (+ trunks), 2 obstacles, 4 fences.
+  std::map<ObjectClass, int> count;
+  for (const auto& object : a.objects) ++count[object.object_class];
+  EXPECT_EQ(count[ObjectClass::kTopiary], 8);
+  EXPECT_EQ(count[ObjectClass::kRose], 4);
+  EXPECT_EQ(count[ObjectClass::kHedge], 2);
+  EXPECT_EQ(count[ObjectClass::kTree], 2);
+  EXPECT_EQ(count[ObjectClass::kTrunk], 2);
+  EXPECT_EQ(count[ObjectClass::kObstacle], 2);
+  EXPECT_EQ(count[ObjectClass::kFence], 4);
+  EXPECT_EQ(a.paths.size(), 2u);
+  // The written file loads back to the same garden.
+  const Garden reloaded = Garden::Load(WriteTempFile("generated.yaml", a.ToYaml()));
+  EXPECT_EQ(reloaded.ToYaml(), a.ToYaml());
+}
+
+TEST(GardenGenerator, KeepsRoomForTheRobotBetweenObjects) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    GeneratorParameters parameters;
+    parameters.seed = seed;
+    const Garden garden = GenerateGarden(parameters);
+    for (size_t i = 0; i < garden.objects.size(); ++i) {
+      for (size_t j = i + 1; j < garden.objects.size(); ++j) {
+        const auto& a = garden.objects[i];
+        const auto& b = garden.objects[j];
+        const bool crown_on_trunk = a.object_class == ObjectClass::kTree || b.object_class == ObjectClass::kTree;
+        if (crown_on_trunk || a.object_class == ObjectClass::kFence || b.object_class == ObjectClass::kFence) continue;
+        // Footprints at least `clearance` apart imply centres at least the two smallest half
+        // extents plus the clearance apart.
+        EXPECT_GE((a.position - b.position).norm(),
+                  a.size.head<2>().minCoeff() / 2 + b.size.head<2>().minCoeff() / 2 + parameters.robot_clearance - 1e-9)
+            << "seed " << seed << ": objects " << a.id << " and " << b.id;
+      }
+    }
+  }
+}
+
+TEST(OccupancyMap, MarksEveryFootprintBelowTheClearance) {
+  const Garden garden = Garden::Load(SourcePath("garden_scenes/gardens/wageningen.yaml"));
+  const double clearance = 1.0;
+  const OccupancyMap map = MakeOccupancyMap(garden, 0.05, clearance);
+  int marked = 0;
+  for (const auto& object : garden.objects) {
+    const cv::Point cell = map.Cell(object.position);
+    ASSERT_TRUE(cell.inside(cv::Rect(0, 0, map.occupied.cols, map.occupied.rows))) << object.id;
+    if (object.base_height < clearance) {
+      EXPECT_EQ(map.occupied.at<uchar>(cell), 255) << "object " << object.id << " not marked";
+      // The whole footprint: cells at 90% of the half extents along the object's axes.
+      for (const auto& [sx, sy] : std::vector<std::pair<double, double>>{{0.9, 0}, {-0.9, 0}, {0, 0.9}, {0, -0.9}}) {
+        const Eigen::Vector2d local(sx * object.size.x() / 2, sy * object.size.y() / 2);
+        EXPECT_EQ(map.occupied.at<uchar>(map.Cell(object.position + Eigen::Rotation2Dd(object.yaw) * local)), 255)
+            << "object " << object.id;
+      }
+      ++marked;
+    }
+  }
+  EXPECT_EQ(marked, 41);  // 44 objects less the three tree crowns (their trunks are marked)
+  // Open lawn is free: between the roses, and in the middle of the garden's west part.
+  EXPECT_EQ(map.occupied.at<uchar>(map.Cell({0.3, 1.4})), 0);
+  EXPECT_EQ(map.occupied.at<uchar>(map.Cell({-1.5, -1.5})), 0);
+  const double occupied_fraction = cv::countNonZero(map.occupied) / static_cast<double>(map.occupied.total());
+  EXPECT_GT(occupied_fraction, 0.03);
+  EXPECT_LT(occupied_fraction, 0.25);
+}
+
+TEST(FoliageMesh, TrimmedIsTheTargetShapeAndGrowthAddsIrregularly) {
+  GardenObject bush;
+  bush.id = 3;
+  bush.object_class = ObjectClass::kTopiary;
+  bush.shape = Shape::kEllipsoid;
+  bush.size = {0.8, 0.8, 0.8};
+  auto radii = [&](double growth) {
+    std::vector<double> r;
+    for (const auto& v : ObjectMesh(bush, 1, growth).vertices) r.push_back((v - Eigen::Vector3d(0, 0, 0.4)).norm());
+    return r;
+  };
+  const auto trimmed = radii(0.0);
+  const auto grown = radii(1.0);
+  double max_deviation = 0.0, mean_growth = 0.0, max_growth = 0.0, min_growth = 1.0;
+  for (size_t i = 0; i < trimmed.size(); ++i) {
+    max_deviation = std::max(max_deviation, std::abs(trimmed[i] - 0.4));
+    mean_growth += (grown[i] - trimmed[i]) / trimmed.size();
+    max_growth = std::max(max_growth, grown[i] - trimmed[i]);
+    min_growth = std::min(min_growth, grown[i] - trimmed[i]);
+  }
+  EXPECT_LT(max_deviation, 0.03);      // leaf clumps only: within 3 cm of the trimmed sphere
+  EXPECT_GT(max_deviation, 0.005);     // ... but not a smooth primitive
+  EXPECT_GT(mean_growth, 0.05);        // a season adds several cm on average
+  EXPECT_LE(max_growth, kMaxGrowth * 1.6 + 1e-9);
+  EXPECT_GT(max_growth - min_growth, 0.05);  // and unevenly (shoots)
+}
+
+TEST(Conditions, SunFollowsTheDayAtWageningen) {
+  Garden garden;  // latitude 52 N, north along +y
+  Conditions noon;
+  noon.time_of_day = 12.0;
+  noon.day_of_year = 172;  // midsummer: 90 - 52 + 23.4 = 61.4 degrees
+  Sun sun = SunFor(garden, noon);
+  EXPECT_NEAR(sun.elevation * 180 / M_PI, 61.4, 0.5);
+  EXPECT_NEAR(std::remainder(sun.azimuth + M_PI / 2, 2 * M_PI), 0.0, 0.01);  // from the south (-y)
+  Conditions evening = noon;
+  evening.time_of_day = 18.0;
+  sun = SunFor(garden, evening);
+  EXPECT_LT(sun.elevation * 180 / M_PI, 30.0);
+  EXPECT_LT(std::cos(sun.azimuth), -0.3);  // from the west, which is -x when north is +y
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "trimbot/garden/garden.h"
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -94,6 +96,15 @@ Garden Garden::Load(const std::string& path) {
 
 bool IsFoliage(ObjectClass c) {
   return c == ObjectClass::kTopiary || c == ObjectClass::kRose || c == ObjectClass::kHedge || c == ObjectClass::kTree;
+}
+
+Surface Garden::SurfaceAt(const Eigen::Vector2d& point) const {
+  Surface surface = ground;
+  for (const auto& path : paths) {
+    const Eigen::Vector2d local = Eigen::Rotation2Dd(-path.yaw) * (point - path.centre);
+    if (std::abs(local.x()) <= path.size.x() / 2 && std::abs(local.y()) <= path.size.y() / 2) surface = path.surface;
+  }
+  return surface;
 }
 
 std::string Garden::ToYaml() const {

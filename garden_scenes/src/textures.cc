@@ -10,21 +10,35 @@
 namespace trimbot::garden {
 namespace {
 
-// Sum of blurred white noise at several scales, normalized to zero mean and unit spread.
-// Wrap-around borders keep the tile seamless when MuJoCo repeats it.
+// Blurred white noise with feature size `scale_px`, seamless (wrap-around). Coarse octaves are
+// made at low resolution and upsampled: a full-resolution blur with a large sigma costs seconds.
+cv::Mat NoiseOctave(cv::RNG& rng, int size, double scale_px) {
+  int low = size;
+  while (low % 2 == 0 && low >= 16 && scale_px * low / size > 4.0) low /= 2;
+  const double sigma = scale_px * low / size;
+  cv::Mat noise(low, low, CV_32F);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+  if (sigma > 0.5) {
+    const int pad = static_cast<int>(std::ceil(3 * sigma));
+    cv::Mat padded;
+    cv::copyMakeBorder(noise, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
+    cv::GaussianBlur(padded, padded, cv::Size(), sigma);
+    noise = padded(cv::Rect(pad, pad, low, low)).clone();
+  }
+  if (low == size) return noise;
+  const int factor = size / low, pad = 2;
+  cv::Mat padded, up;
+  cv::copyMakeBorder(noise, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
+  cv::resize(padded, up, cv::Size(), factor, factor, cv::INTER_CUBIC);
+  return up(cv::Rect(pad * factor, pad * factor, size, size)).clone();
+}
+
+// Sum of noise octaves, normalized to zero mean and unit spread.
 cv::Mat FractalNoise(cv::RNG& rng, int size, const std::vector<double>& scales_px,
                      const std::vector<double>& weights) {
   cv::Mat sum = cv::Mat::zeros(size, size, CV_32F);
   for (size_t i = 0; i < scales_px.size(); ++i) {
-    cv::Mat noise(size, size, CV_32F);
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
-    if (scales_px[i] > 0.5) {
-      const int pad = static_cast<int>(std::ceil(3 * scales_px[i]));
-      cv::Mat padded;
-      cv::copyMakeBorder(noise, padded, pad, pad, pad, pad, cv::BORDER_WRAP);
-      cv::GaussianBlur(padded, padded, cv::Size(), scales_px[i]);
-      noise = padded(cv::Rect(pad, pad, size, size)).clone();
-    }
+    cv::Mat noise = NoiseOctave(rng, size, scales_px[i]);
     cv::Scalar mean, stddev;
     cv::meanStdDev(noise, mean, stddev);
     sum += (noise - mean[0]) * (weights[i] / std::max(stddev[0], 1e-9));
@@ -57,17 +71,26 @@ void DrawWrapped(cv::Mat& image, const cv::Point2f& p, DrawFn draw) {
 }
 
 cv::Mat Grass(cv::RNG& rng, int size) {
-  cv::Mat field = FractalNoise(rng, size, {size / 8.0, size / 40.0, 2.0}, {1.0, 0.7, 0.4});
-  cv::Mat image = Tint(field, {45, 120, 75}, {12, 25, 14});
+  cv::Mat field = FractalNoise(rng, size, {size / 8.0, size / 40.0, 6.0, 2.0}, {1.0, 0.7, 0.5, 0.4});
+  cv::Mat image = Tint(field, {45, 120, 75}, {14, 30, 16});
+  // Gaps where soil shows through and clumps of lighter, sunlit grass, a few cm across.
+  const int patches = size * size / 900;
+  for (int i = 0; i < patches; ++i) {
+    const cv::Point2f p(rng.uniform(0.f, static_cast<float>(size)), rng.uniform(0.f, static_cast<float>(size)));
+    const int radius = rng.uniform(2, 7);
+    const bool gap = rng.uniform(0.0, 1.0) < 0.5;
+    const cv::Scalar colour = gap ? cv::Scalar(25, 45, 50) : cv::Scalar(70, 170, 110);
+    DrawWrapped(image, p, [&](cv::Point2f q) { cv::circle(image, q, radius, colour, -1, cv::LINE_AA); });
+  }
   // Blades: short strokes, lighter and darker than the base, in random directions.
-  const int blades = size * size / 30;
+  const int blades = size * size / 25;
   for (int i = 0; i < blades; ++i) {
     const cv::Point2f p(rng.uniform(0.f, static_cast<float>(size)), rng.uniform(0.f, static_cast<float>(size)));
     const float angle = rng.uniform(0.f, static_cast<float>(CV_PI));
-    const float length = rng.uniform(3.f, 10.f);
+    const float length = rng.uniform(4.f, 14.f);
     const cv::Point2f d(std::cos(angle) * length, std::sin(angle) * length);
     const double shade = rng.uniform(-1.0, 1.0);
-    const cv::Scalar colour(40 + 20 * shade, 115 + 60 * shade, 70 + 35 * shade);
+    const cv::Scalar colour(40 + 25 * shade, 115 + 70 * shade, 70 + 40 * shade);
     DrawWrapped(image, p, [&](cv::Point2f q) { cv::line(image, q, q + d, colour, 1, cv::LINE_AA); });
   }
   return image;
@@ -89,13 +112,36 @@ cv::Mat Gravel(cv::RNG& rng, int size) {
 }
 
 cv::Mat Pavement(cv::RNG& rng, int size) {
-  cv::Mat field = FractalNoise(rng, size, {size / 6.0, 6.0, 1.0}, {0.6, 0.5, 0.6});
-  cv::Mat image = Tint(field, {150, 155, 160}, {14, 14, 14});
-  // Slabs of 50 cm with dark joints (the tile covers 2 m).
+  // Concrete slabs of 50 cm (the tile covers 2 m): each slab its own tone, a granular speckle,
+  // stains and lichen spots, dark joints.
+  cv::Mat field = FractalNoise(rng, size, {size / 6.0, 10.0, 1.0}, {0.6, 0.6, 0.7});
+  cv::Mat image = Tint(field, {150, 155, 160}, {16, 16, 16});
   const int slab = size / 4;
+  for (int sx = 0; sx < 4; ++sx) {
+    for (int sy = 0; sy < 4; ++sy) {
+      const double tone = rng.uniform(-22.0, 22.0);
+      cv::Mat part = image(cv::Rect(sx * slab, sy * slab, slab, slab));
+      part += cv::Scalar(tone, tone, tone);
+    }
+  }
+  const int speckles = size * size / 40;
+  for (int i = 0; i < speckles; ++i) {
+    const cv::Point p(rng.uniform(0, size), rng.uniform(0, size));
+    const double g = rng.uniform(0.0, 1.0) < 0.5 ? rng.uniform(60.0, 110.0) : rng.uniform(190.0, 240.0);
+    cv::circle(image, p, rng.uniform(1, 3), cv::Scalar(g, g, g * 1.02), -1, cv::LINE_AA);
+  }
+  const int stains = size * size / 6000;
+  for (int i = 0; i < stains; ++i) {
+    const cv::Point2f p(rng.uniform(0.f, static_cast<float>(size)), rng.uniform(0.f, static_cast<float>(size)));
+    const bool lichen = rng.uniform(0.0, 1.0) < 0.5;
+    const cv::Scalar colour = lichen ? cv::Scalar(120, 170, 175) : cv::Scalar(95, 100, 105);
+    const cv::Size axes(rng.uniform(4, 16), rng.uniform(3, 12));
+    const double angle = rng.uniform(0.0, 180.0);
+    DrawWrapped(image, p, [&](cv::Point2f q) { cv::ellipse(image, q, axes, angle, 0, 360, colour, -1, cv::LINE_AA); });
+  }
   for (int k = 0; k <= 4; ++k) {
-    cv::line(image, {k * slab, 0}, {k * slab, size}, cv::Scalar(80, 85, 90), 3);
-    cv::line(image, {0, k * slab}, {size, k * slab}, cv::Scalar(80, 85, 90), 3);
+    cv::line(image, {k * slab, 0}, {k * slab, size}, cv::Scalar(70, 75, 80), 4);
+    cv::line(image, {0, k * slab}, {size, k * slab}, cv::Scalar(70, 75, 80), 4);
   }
   return image;
 }

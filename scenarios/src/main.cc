@@ -5,6 +5,7 @@
 
 #include "bench_command.h"
 #include "drive_command.h"
+#include "garden_command.h"
 #include "trimbot/common/input_error.h"
 
 int main(int argc, char** argv) {
@@ -38,8 +39,14 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--frames", bench.frames, "ring frames per measurement")->check(CLI::PositiveNumber);
   bench_cmd->add_option("--drive-seconds", bench.drive_seconds, "simulated seconds of the drive measurement");
 
-  CLI11_PARSE(app, argc, argv);
+  AddGardenCommands(app, data_root);
+
   try {
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e);
+    }
     if (drive_cmd->parsed()) {
       drive.paths = {data_root};
       if (seed_option->count() > 0) drive.seed = seed;
@@ -51,6 +58,7 @@ int main(int argc, char** argv) {
       bench.paths = {data_root};
       return RunBench(bench);
     }
+    return 0;
   } catch (const trimbot::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

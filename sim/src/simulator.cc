@@ -121,7 +121,10 @@ const garden::SlipModel* Simulator::SurfaceUnder(int wheel_geom) const {
     if (contact.geom1 == wheel_geom) other = contact.geom2;
     if (contact.geom2 == wheel_geom) other = contact.geom1;
     const GeomLabel* label = world.label(other);
-    if (label != nullptr && label->is_ground) return &impl_->ground_slip[static_cast<int>(label->surface)];
+    if (label != nullptr && label->is_ground) {
+      const garden::Surface surface = garden_.SurfaceAt({contact.pos[0], contact.pos[1]});
+      return &impl_->ground_slip[static_cast<int>(surface)];
+    }
   }
   return nullptr;
 }

@@ -183,7 +183,9 @@ class MjcfEmitter {
 std::string WriteTexture(garden::Material material, const WorldOptions& options, const fs::path& dir) {
   const fs::path path = dir / (garden::ToString(material) + ".png");
   std::vector<uchar> png;
-  cv::imencode(".png", garden::MakeTexture(material, options.seed, options.texture_size), png);
+  // Ground tiles cover 2-4 m and are seen from 0.5 m up: they get twice the resolution.
+  const int size = garden::TileSize(material) > 1.0 ? 2 * options.texture_size : options.texture_size;
+  cv::imencode(".png", garden::MakeTexture(material, options.seed, size), png);
   WriteFileAtomically(path.string(), std::string(png.begin(), png.end()));
   return fs::absolute(path).string();
 }
@@ -238,7 +240,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
         << " 0.005 0.0001\"/>\n";
   spec.labels.push_back({"garden/ground", ObjectClass::kGround, garden::kGroundObjectId, true, garden.ground});
   auto emit_mesh = [&](const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose,
-                       const std::string& material, const std::string& extra) {
+                       const std::string& material, const std::string& geom_class) {
     assets << "    <mesh name=\"" << name << "\" vertex=\"";
     for (const auto& v : mesh.vertices) assets << Num(v.x()) << ' ' << Num(v.y()) << ' ' << Num(v.z()) << ' ';
     assets << "\" texcoord=\"";
@@ -248,10 +250,11 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     assets << "\"/>\n";
     Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
     iso.matrix() = pose;
-    world << "    <geom name=\"" << name << "\" class=\"garden\" type=\"mesh\" mesh=\"" << name << "\" "
-          << PoseAttributes(iso) << " material=\"" << material << "\"" << extra << "/>\n";
+    world << "    <geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"mesh\" mesh=\"" << name
+          << "\" " << PoseAttributes(iso) << " material=\"" << material << "\"/>\n";
   };
-  // Paths and beds: 4 mm slabs on the lawn, so the wheels touch (and slip on) their surface.
+  // Paths and beds are flush with the lawn: drawn as 2 mm slabs that do not collide (a slab edge
+  // would stop a wheel); the simulator finds the surface under a wheel from the garden's paths.
   for (size_t i = 0; i < garden.paths.size(); ++i) {
     const auto& path = garden.paths[i];
     const garden::Material material = garden::GroundMaterial(path.surface);
@@ -259,15 +262,14 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     garden::GardenObject slab;
     slab.position = path.centre;
     slab.yaw = path.yaw;
-    emit_mesh(name, garden::BoxMesh({path.size.x(), path.size.y(), 0.004}, garden::TileSize(material)),
-              garden::ObjectPose(slab), garden::ToString(material),
-              " friction=\"" + Num(garden::PropertiesOf(path.surface).friction) + " 0.005 0.0001\"");
+    emit_mesh(name, garden::BoxMesh({path.size.x(), path.size.y(), 0.002}, garden::TileSize(material)),
+              garden::ObjectPose(slab), garden::ToString(material), "garden_surface");
     spec.labels.push_back({name, ObjectClass::kGround, garden::kGroundObjectId, true, path.surface});
   }
   for (const auto& object : garden.objects) {
     const std::string name = "garden/" + std::to_string(object.id) + "_" + garden::ToString(object.object_class);
     emit_mesh(name, garden::ObjectMesh(object, options.seed, options.conditions.growth), garden::ObjectPose(object),
-              garden::ToString(garden::MaterialOf(object.object_class)), "");
+              garden::ToString(garden::MaterialOf(object.object_class)), "garden");
     spec.labels.push_back({name, object.object_class, static_cast<std::uint16_t>(object.id), false, garden.ground});
   }
 
@@ -300,6 +302,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
       << "      <default class=\"arm_joint\"><joint damping=\"3\" armature=\"0.05\"/></default>\n"
       << "    </default>\n"
       << "    <default class=\"garden\"><geom contype=\"1\" conaffinity=\"2\" group=\"0\"/></default>\n"
+      << "    <default class=\"garden_surface\"><geom contype=\"0\" conaffinity=\"0\" group=\"0\"/></default>\n"
       << "  </default>\n"
       << "  <asset>\n"
       << assets.str() << "  </asset>\n"

@@ -44,6 +44,8 @@ struct Garden {
   // Throws InputError naming the file, line and key.
   static Garden Load(const std::string& path);
   std::string ToYaml() const;
+  // Ground surface at a map point: the last path containing it, else the lawn.
+  Surface SurfaceAt(const Eigen::Vector2d& point) const;
   // Finds garden_scenes/gardens/<name>.yaml, or takes a path to a .yaml file.
   static std::string Resolve(const std::string& name_or_path, const std::string& gardens_dir);
 };

@@ -1,0 +1,54 @@
+#pragma once
+// Tools over gardens: import from the TrimBot2020 GardenUI object map (CSV), a seeded generator of
+// new gardens, and exports of the 2D occupancy map (map_server) and the ground-truth geometry (PLY).
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <string>
+
+#include "trimbot/garden/garden.h"
+
+namespace trimbot::garden {
+
+// GardenUI CSV (id,label,shape,size_x,size_y,size_z,pos_x,pos_y,pos_z,yaw_deg; metres; z of the
+// ground = ground_z). Labels map to classes (Topiary-* -> topiary, Hedge-* -> hedge, Rose-* -> rose,
+// Obstacle-Tree -> tree, Obstacle-Trunk -> trunk, Obstacle-Fence/Post -> fence, others -> obstacle).
+// Objects starting less than 0.3 m up are grounded (their tops kept). Throws InputError naming the
+// file and line.
+Garden ImportGardenUiCsv(const std::string& path, double ground_z);
+
+struct GeneratorParameters {
+  std::uint64_t seed = 0;
+  Eigen::Vector2d size = Eigen::Vector2d(16, 12);
+  int topiary = 8;
+  int roses = 4;
+  int hedges = 2;
+  int trees = 2;
+  int obstacles = 2;
+  int paths = 2;
+  bool fence = true;              // a low fence around the garden
+  double robot_clearance = 0.9;   // m of free space kept between objects so the robot can pass
+};
+// A new garden from the parameters; the same seed gives the same garden. Objects do not overlap
+// each other or the paths and keep robot_clearance between them.
+Garden GenerateGarden(const GeneratorParameters& parameters);
+
+struct OccupancyMap {
+  cv::Mat occupied;           // CV_8U, 255 = occupied, row 0 = the map's top (largest y)
+  double resolution = 0.05;   // m per cell
+  Eigen::Vector2d origin;     // map coordinates of the bottom-left corner of the bottom-left cell
+  // Cell (column, row) holding a map point.
+  cv::Point Cell(const Eigen::Vector2d& point) const;
+};
+// Footprints of every object whose lowest point is below `clearance` (tree crowns higher than the
+// robot are not obstacles to it; their trunks are).
+OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance);
+// Writes <dir>/<name>.png and <dir>/<name>.yaml in ROS map_server format.
+void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const std::string& name);
+
+// Samples the garden's surfaces (ground, paths, object meshes as grown under `growth`) into an
+// ASCII PLY point cloud with per-point class and object id.
+void WriteGroundTruthPly(const Garden& garden, std::uint64_t seed, double growth, double points_per_m2,
+                         const std::string& path);
+
+}  // namespace trimbot::garden

@@ -1,0 +1,301 @@
+#include "trimbot/garden/garden_tools.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
+#include "trimbot/garden/object_mesh.h"
+
+namespace trimbot::garden {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+ObjectClass ClassOfLabel(const std::string& label) {
+  if (label.rfind("Topiary", 0) == 0) return ObjectClass::kTopiary;
+  if (label.rfind("Hedge", 0) == 0) return ObjectClass::kHedge;
+  if (label.rfind("Rose", 0) == 0) return ObjectClass::kRose;
+  if (label == "Obstacle-Tree") return ObjectClass::kTree;
+  if (label == "Obstacle-Trunk") return ObjectClass::kTrunk;
+  if (label == "Obstacle-Fence" || label == "Obstacle-Post") return ObjectClass::kFence;
+  return ObjectClass::kObstacle;
+}
+
+// Corners of an object's (or patch's) footprint rectangle in the map frame.
+std::vector<Eigen::Vector2d> FootprintCorners(const Eigen::Vector2d& centre, const Eigen::Vector2d& size, double yaw) {
+  const Eigen::Rotation2Dd rotation(yaw);
+  std::vector<Eigen::Vector2d> corners;
+  for (const auto& [sx, sy] : std::vector<std::pair<double, double>>{{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+    corners.push_back(centre + rotation * Eigen::Vector2d(sx * size.x() / 2, sy * size.y() / 2));
+  }
+  return corners;
+}
+
+// Separating-axis test for two rotated rectangles grown by `margin`.
+bool Overlap(const Eigen::Vector2d& c1, const Eigen::Vector2d& s1, double yaw1, const Eigen::Vector2d& c2,
+             const Eigen::Vector2d& s2, double yaw2, double margin) {
+  const auto a = FootprintCorners(c1, s1 + Eigen::Vector2d::Constant(margin), yaw1);
+  const auto b = FootprintCorners(c2, s2 + Eigen::Vector2d::Constant(margin), yaw2);
+  for (const double yaw : {yaw1, yaw1 + M_PI / 2, yaw2, yaw2 + M_PI / 2}) {
+    const Eigen::Vector2d axis(std::cos(yaw), std::sin(yaw));
+    double a_min = 1e9, a_max = -1e9, b_min = 1e9, b_max = -1e9;
+    for (const auto& p : a) a_min = std::min(a_min, p.dot(axis)), a_max = std::max(a_max, p.dot(axis));
+    for (const auto& p : b) b_min = std::min(b_min, p.dot(axis)), b_max = std::max(b_max, p.dot(axis));
+    if (a_max < b_min || b_max < a_min) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "file not found");
+  Garden garden;
+  garden.source = path;
+  std::string line;
+  int line_number = 0;
+  Eigen::Vector2d low(1e9, 1e9), high(-1e9, -1e9);
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line[0] == '#' || line.rfind("id,", 0) == 0) continue;
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
+    if (fields.size() != 10) {
+      throw InputError(path, "line " + std::to_string(line_number) + ": expected 10 fields, got " + std::to_string(fields.size()));
+    }
+    GardenObject object;
+    try {
+      object.id = std::stoi(fields[0]);
+      object.size = {std::stod(fields[3]), std::stod(fields[4]), std::stod(fields[5])};
+      object.position = {std::stod(fields[6]), std::stod(fields[7])};
+      object.base_height = std::stod(fields[8]) - ground_z;
+      object.yaw = std::stod(fields[9]) * kDegToRad;
+    } catch (const std::exception&) {
+      throw InputError(path, "line " + std::to_string(line_number) + ": not a number where one is expected");
+    }
+    object.object_class = ClassOfLabel(fields[1]);
+    // GardenUI boxes are bounding boxes: topiary and tree crowns are round, roses and trunks cylinders.
+    switch (object.object_class) {
+      case ObjectClass::kTopiary:
+      case ObjectClass::kTree: object.shape = Shape::kEllipsoid; break;
+      case ObjectClass::kRose:
+      case ObjectClass::kTrunk: object.shape = Shape::kCylinder; break;
+      default: object.shape = Shape::kBox; break;
+    }
+    // The boxes were fitted to point clouds whose lowest points lie above the ground (grass hides
+    // the base): objects that start low stand on the ground, keeping their tops. Tree crowns stay up.
+    if (object.base_height < 0.3) {
+      object.size.z() += object.base_height;  // also for boxes reaching a little below the ground
+      object.base_height = 0.0;
+    }
+    low = low.cwiseMin(object.position - object.size.head<2>() / 2);
+    high = high.cwiseMax(object.position + object.size.head<2>() / 2);
+    garden.objects.push_back(object);
+  }
+  if (garden.objects.empty()) throw InputError(path, "no objects");
+  garden.centre = (low + high) / 2;
+  garden.size = (high - low) + Eigen::Vector2d(2.0, 2.0);
+  return garden;
+}
+
+Garden GenerateGarden(const GeneratorParameters& p) {
+  Rng rng = MakeRng(p.seed, "garden_generator");
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  Garden garden;
+  garden.name = "generated_" + std::to_string(p.seed);
+  garden.size = p.size + Eigen::Vector2d(2.0, 2.0);
+  garden.centre = Eigen::Vector2d::Zero();
+  const Eigen::Vector2d half = p.size / 2;
+
+  // Paths: straight strips across the garden, alternately along x and y.
+  const Surface path_surfaces[] = {Surface::kGravel, Surface::kPavement, Surface::kSoil};
+  for (int i = 0; i < p.paths; ++i) {
+    GroundPatch patch;
+    patch.surface = path_surfaces[i % 3];
+    const bool along_x = i % 2 == 0;
+    const double width = uniform(0.8, 1.5);
+    patch.size = along_x ? Eigen::Vector2d(p.size.x() * uniform(0.5, 0.9), width)
+                         : Eigen::Vector2d(width, p.size.y() * uniform(0.5, 0.9));
+    patch.centre = {uniform(-half.x() + patch.size.x() / 2, half.x() - patch.size.x() / 2),
+                    uniform(-half.y() + patch.size.y() / 2, half.y() - patch.size.y() / 2)};
+    garden.paths.push_back(patch);
+  }
+
+  int next_id = 1;
+  // Places an object where it overlaps nothing else, with the robot's clearance; gives up after
+  // a number of tries (a crowded garden just gets fewer objects).
+  auto place = [&](GardenObject object, double margin) {
+    for (int attempt = 0; attempt < 200; ++attempt) {
+      object.position = {uniform(-half.x() + object.size.x() / 2 + 0.5, half.x() - object.size.x() / 2 - 0.5),
+                         uniform(-half.y() + object.size.y() / 2 + 0.5, half.y() - object.size.y() / 2 - 0.5)};
+      bool free = true;
+      for (const auto& other : garden.objects) {
+        if (other.object_class == ObjectClass::kFence) continue;
+        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, other.position,
+                                other.size.head<2>(), other.yaw, margin);
+      }
+      for (const auto& path : garden.paths) {
+        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, path.centre, path.size, path.yaw, 0.1);
+      }
+      if (free) {
+        object.id = next_id++;
+        garden.objects.push_back(object);
+        return &garden.objects.back();
+      }
+    }
+    return static_cast<GardenObject*>(nullptr);
+  };
+  auto make = [&](ObjectClass c, Shape shape, const Eigen::Vector3d& size, double yaw = 0.0) {
+    GardenObject o;
+    o.object_class = c;
+    o.shape = shape;
+    o.size = size;
+    o.yaw = yaw;
+    return o;
+  };
+  for (int i = 0; i < p.trees; ++i) {
+    const double crown = uniform(2.4, 3.6);
+    GardenObject trunk = make(ObjectClass::kTrunk, Shape::kCylinder, {0.3, 0.3, uniform(1.4, 1.8)});
+    if (GardenObject* placed = place(trunk, p.robot_clearance)) {
+      GardenObject tree = make(ObjectClass::kTree, Shape::kEllipsoid, {crown, crown * uniform(0.9, 1.1), uniform(2.5, 3.4)});
+      tree.position = placed->position;
+      tree.base_height = placed->size.z() - 0.3;
+      tree.id = next_id++;
+      garden.objects.push_back(tree);
+    }
+  }
+  for (int i = 0; i < p.hedges; ++i) {
+    const double length = uniform(2.0, 5.0);
+    place(make(ObjectClass::kHedge, Shape::kBox, {length, uniform(0.5, 0.8), uniform(0.4, 1.4)},
+               unit(rng) < 0.5 ? 0.0 : M_PI / 2),
+          p.robot_clearance);
+  }
+  for (int i = 0; i < p.topiary; ++i) {
+    const double d = uniform(0.6, 0.9);
+    place(make(ObjectClass::kTopiary, unit(rng) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
+               {d, d * uniform(0.9, 1.1), d * uniform(0.6, 1.0)}),
+          p.robot_clearance);
+  }
+  for (int i = 0; i < p.roses; ++i) {
+    const double d = uniform(0.5, 0.8);
+    place(make(ObjectClass::kRose, Shape::kCylinder, {d, d, uniform(0.5, 0.8)}), p.robot_clearance);
+  }
+  for (int i = 0; i < p.obstacles; ++i) {
+    place(make(ObjectClass::kObstacle, Shape::kBox, {uniform(0.3, 1.2), uniform(0.3, 1.0), uniform(0.3, 0.9)},
+               uniform(0.0, M_PI)),
+          p.robot_clearance);
+  }
+  if (p.fence) {
+    for (int side = 0; side < 4; ++side) {
+      const bool along_x = side < 2;
+      const double offset = (side % 2 == 0 ? -1 : 1) * (along_x ? half.y() : half.x());
+      GardenObject fence = make(ObjectClass::kFence, Shape::kBox,
+                                along_x ? Eigen::Vector3d(p.size.x(), 0.1, 0.8) : Eigen::Vector3d(0.1, p.size.y(), 0.8));
+      fence.position = along_x ? Eigen::Vector2d(0.0, offset) : Eigen::Vector2d(offset, 0.0);
+      fence.id = next_id++;
+      garden.objects.push_back(fence);
+    }
+  }
+  return garden;
+}
+
+cv::Point OccupancyMap::Cell(const Eigen::Vector2d& point) const {
+  const int column = static_cast<int>(std::floor((point.x() - origin.x()) / resolution));
+  const int row_from_bottom = static_cast<int>(std::floor((point.y() - origin.y()) / resolution));
+  return {column, occupied.rows - 1 - row_from_bottom};
+}
+
+OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance) {
+  OccupancyMap map;
+  map.resolution = resolution;
+  map.origin = garden.centre - garden.size / 2;
+  const int columns = static_cast<int>(std::ceil(garden.size.x() / resolution));
+  const int rows = static_cast<int>(std::ceil(garden.size.y() / resolution));
+  map.occupied = cv::Mat::zeros(rows, columns, CV_8U);
+  for (const auto& object : garden.objects) {
+    if (object.base_height >= clearance) continue;
+    std::vector<cv::Point> polygon;
+    if (object.shape == Shape::kBox) {
+      for (const auto& corner : FootprintCorners(object.position, object.size.head<2>(), object.yaw)) {
+        polygon.push_back(map.Cell(corner));
+      }
+    } else {
+      for (int i = 0; i < 48; ++i) {
+        const double a = 2.0 * M_PI * i / 48;
+        const Eigen::Vector2d local(object.size.x() / 2 * std::cos(a), object.size.y() / 2 * std::sin(a));
+        polygon.push_back(map.Cell(object.position + Eigen::Rotation2Dd(object.yaw) * local));
+      }
+    }
+    cv::fillConvexPoly(map.occupied, polygon, cv::Scalar(255));
+    cv::polylines(map.occupied, polygon, true, cv::Scalar(255));  // thin objects keep at least one cell
+  }
+  return map;
+}
+
+void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const std::string& name) {
+  // map_server convention: dark = occupied.
+  cv::Mat image = 255 - map.occupied;
+  std::vector<uchar> png;
+  cv::imencode(".png", image, png);
+  WriteFileAtomically(dir + "/" + name + ".png", std::string(png.begin(), png.end()));
+  std::ostringstream yaml;
+  yaml << std::setprecision(10) << "image: " << name << ".png\n"
+       << "resolution: " << map.resolution << "\n"
+       << "origin: [" << map.origin.x() << ", " << map.origin.y() << ", 0.0]\n"
+       << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  WriteFileAtomically(dir + "/" + name + ".yaml", yaml.str());
+}
+
+void WriteGroundTruthPly(const Garden& garden, std::uint64_t seed, double growth, double points_per_m2,
+                         const std::string& path) {
+  Rng rng = MakeRng(seed, "ground_truth_ply");
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::ostringstream body;
+  body << std::setprecision(6);
+  long count = 0;
+  auto sample_mesh = [&](const Mesh& mesh, const Eigen::Matrix4d& pose, ObjectClass c, int id) {
+    for (const auto& f : mesh.faces) {
+      const Eigen::Vector3d a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], d = mesh.vertices[f[2]];
+      const double area = 0.5 * (b - a).cross(d - a).norm();
+      // Whole expected count plus a random remainder keeps the density exact on average.
+      const double expected = area * points_per_m2;
+      const int n = static_cast<int>(expected) + (unit(rng) < expected - std::floor(expected) ? 1 : 0);
+      for (int k = 0; k < n; ++k) {
+        double u = unit(rng), v = unit(rng);
+        if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+        const Eigen::Vector3d local = a + u * (b - a) + v * (d - a);
+        const Eigen::Vector3d p = (pose * local.homogeneous()).head<3>();
+        body << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << static_cast<int>(c) << ' ' << id << '\n';
+        ++count;
+      }
+    }
+  };
+  Mesh lawn;
+  const Eigen::Vector2d low = garden.centre - garden.size / 2, high = garden.centre + garden.size / 2;
+  lawn.vertices = {{low.x(), low.y(), 0}, {high.x(), low.y(), 0}, {high.x(), high.y(), 0}, {low.x(), high.y(), 0}};
+  lawn.faces = {{0, 1, 2}, {0, 2, 3}};
+  sample_mesh(lawn, Eigen::Matrix4d::Identity(), ObjectClass::kGround, kGroundObjectId);
+  for (const auto& object : garden.objects) {
+    sample_mesh(ObjectMesh(object, seed, growth), ObjectPose(object), object.object_class, object.id);
+  }
+  std::ostringstream ply;
+  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << seed << " growth " << growth
+      << "\nelement vertex " << count
+      << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar class\nproperty ushort object\n"
+         "end_header\n"
+      << body.str();
+  WriteFileAtomically(path, ply.str());
+}
+
+}  // namespace trimbot::garden
