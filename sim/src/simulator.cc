@@ -51,6 +51,8 @@ struct Simulator::Impl {
   int imu_steps = 1, encoder_steps = 1, camera_steps = 1;
   double last_left_angle = 0.0, last_right_angle = 0.0;
   garden::SlipModel ground_slip[4];
+  std::unique_ptr<PoseFixModel> pose_fixes;
+  std::vector<bool> fault_applied;
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
@@ -79,10 +81,18 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->camera_steps = StepsPerSample(parameters_.cameras.rate_hz, config.timestep, params, "camera");
 
   impl_->base = std::make_unique<BaseController>(robot_.drive(), parameters_.drive);
+  for (double* p : {&parameters_.imu.accelerometer_noise_density, &parameters_.imu.accelerometer_random_walk,
+                    &parameters_.imu.accelerometer_initial_bias_sigma, &parameters_.imu.gyroscope_noise_density,
+                    &parameters_.imu.gyroscope_random_walk, &parameters_.imu.gyroscope_initial_bias_sigma}) {
+    *p *= config.imu_noise_scale;
+  }
   impl_->imu = std::make_unique<ImuModel>(parameters_.imu, config.seed);
   impl_->encoders = std::make_unique<WheelEncoderModel>(parameters_.wheel_encoders.ticks_per_revolution, config.seed);
   for (auto surface : {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement, garden::Surface::kSoil}) {
-    impl_->ground_slip[static_cast<int>(surface)] = garden::PropertiesOf(surface).slip;
+    garden::SlipModel& slip = impl_->ground_slip[static_cast<int>(surface)];
+    slip = garden::PropertiesOf(surface).slip;
+    slip.mean *= config.wheel_slip_scale;
+    slip.sigma *= config.wheel_slip_scale;
   }
 
   // The arm starts in its home pose, held by its servos.
@@ -97,6 +107,8 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->arm = std::make_unique<ArmController>(parameters_.arm_home_position, ranges);
   mj_forward(m, d);
 
+  impl_->pose_fixes = std::make_unique<PoseFixModel>(config.pose_fixes, config.seed);
+  impl_->fault_applied.assign(config.faults.size(), false);
   if (config.render_cameras) {
     impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.resolution_scale);
   }
@@ -150,6 +162,7 @@ void Simulator::Step(StepOutputs* outputs) {
   d->ctrl[world.cutter().actuator] = impl_->cutter_on ? 300.0 : 0.0;
 
   const double stamp_before = d->time;
+  const bool cameras_available = ApplyFaults();
   mj_step(m, d);
   ++impl_->step;
 
@@ -169,10 +182,46 @@ void Simulator::Step(StepOutputs* outputs) {
   impl_->last_right_angle = right_angle;
   if (impl_->step % impl_->encoder_steps == 0) outputs->wheel_ticks.push_back(impl_->encoders->Read(d->time));
 
-  if (impl_->renderer && impl_->step % impl_->camera_steps == 0) {
-    const int every = config_.ground_truth_every_frames;
-    outputs->ring = CaptureRing(every > 0 && impl_->frame % every == 0);
+  if (cameras_available && impl_->step % impl_->camera_steps == 0) {
+    if (impl_->renderer) {
+      const int every = config_.ground_truth_every_frames;
+      outputs->ring = CaptureRing(every > 0 && impl_->frame % every == 0);
+    }
+    const Eigen::Isometry3d T_map_base = ground_truth().T_map_base;
+    const Eigen::Vector3d x_axis = T_map_base.linear().col(0);
+    impl_->pose_fixes->Capture(d->time, T_map_base.translation().x(), T_map_base.translation().y(),
+                               std::atan2(x_axis.y(), x_axis.x()));
   }
+  impl_->pose_fixes->Deliver(d->time, &outputs->pose_fixes);
+}
+
+bool Simulator::ApplyFaults() {
+  const double t = impl_->world->data()->time;
+  double slip_left = 0.0, slip_right = 0.0;
+  bool cameras_available = true;
+  for (std::size_t i = 0; i < config_.faults.size(); ++i) {
+    const Fault& fault = config_.faults[i];
+    switch (fault.kind) {
+      case Fault::Kind::kWheelSlip:
+        if (fault.ActiveAt(t)) {
+          slip_left += fault.slip_left;
+          slip_right += fault.slip_right;
+        }
+        break;
+      case Fault::Kind::kImuBiasJump:
+        if (!impl_->fault_applied[i] && t >= fault.start) {
+          impl_->imu->AddGyroscopeBias(fault.gyroscope_bias_jump);
+          impl_->imu->AddAccelerometerBias(fault.accelerometer_bias_jump);
+          impl_->fault_applied[i] = true;
+        }
+        break;
+      case Fault::Kind::kCameraDropout:
+        if (fault.ActiveAt(t)) cameras_available = false;
+        break;
+    }
+  }
+  impl_->encoders->SetExtraSlip(slip_left, slip_right);
+  return cameras_available;
 }
 
 RingCapture Simulator::CaptureRing(bool with_ground_truth) {

@@ -12,7 +12,7 @@ void WheelEncoderModel::AdvanceWheel(Wheel& wheel, double dt, double rotation, c
   if (surface != nullptr) {
     const double decay = std::exp(-dt / surface->correlation_time);
     wheel.slip_state = decay * wheel.slip_state + surface->sigma * std::sqrt(1.0 - decay * decay) * normal_(rng_);
-    slip = surface->mean + wheel.slip_state + extra_slip_;
+    slip = surface->mean + wheel.slip_state + wheel.extra_slip;
   }
   wheel.measured_angle += rotation * (1.0 + slip);
 }

@@ -21,6 +21,8 @@
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
 #include "trimbot/robot/robot_parameters.h"
+#include "trimbot/sim/faults.h"
+#include "trimbot/sim/pose_fix_model.h"
 #include "trimbot/sim/ring_renderer.h"
 #include "trimbot/sim/world_builder.h"
 
@@ -40,6 +42,10 @@ struct SimulatorConfig {
   int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
   double resolution_scale = 1.0;     // 0.5 renders half-resolution images
   int msaa_samples = 4;              // anti-aliasing; 0 halves the render time, edges get jagged
+  PoseFixModelParameters pose_fixes; // stand-in for visual localization (off by default)
+  double imu_noise_scale = 1.0;      // multiplies every IMU noise parameter
+  double wheel_slip_scale = 1.0;     // multiplies the surfaces' slip (mean and spread)
+  std::vector<Fault> faults;         // injected at their times
 };
 
 // Ground truth at the current time, in the map frame (MuJoCo's world frame).
@@ -71,10 +77,12 @@ struct StepOutputs {
   std::vector<messages::ImuSample> imu;
   std::vector<messages::WheelTicks> wheel_ticks;
   std::optional<RingCapture> ring;
+  std::vector<messages::PoseFix> pose_fixes;
   void Clear() {
     imu.clear();
     wheel_ticks.clear();
     ring.reset();
+    pose_fixes.clear();
   }
 };
 
@@ -107,6 +115,8 @@ class Simulator {
 
  private:
   const garden::SlipModel* SurfaceUnder(int wheel_geom) const;
+  // Applies the faults due at the current time; returns whether the cameras deliver images.
+  bool ApplyFaults();
 
   SimulatorConfig config_;
   robot::RobotDescription robot_;

@@ -22,13 +22,17 @@ class WheelEncoderModel {
   void Advance(double dt, double rotation_left, double rotation_right, const garden::SlipModel* surface_left,
                const garden::SlipModel* surface_right);
   messages::WheelTicks Read(double stamp) const;
-  // Fault: add extra slip for a while (a muddy patch); fraction added to both wheels.
-  void SetExtraSlip(double fraction) { extra_slip_ = fraction; }
+  // Fault: extra slip per wheel for a while (a muddy patch), as a fraction of the travel.
+  void SetExtraSlip(double left, double right) {
+    left_.extra_slip = left;
+    right_.extra_slip = right;
+  }
 
  private:
   struct Wheel {
     double measured_angle = 0.0;  // rad, what the encoder has seen
     double slip_state = 0.0;      // Gauss-Markov deviation from the mean slip
+    double extra_slip = 0.0;      // injected fault
   };
   void AdvanceWheel(Wheel& wheel, double dt, double rotation, const garden::SlipModel* surface);
 
@@ -36,7 +40,6 @@ class WheelEncoderModel {
   Rng rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   Wheel left_, right_;
-  double extra_slip_ = 0.0;
 };
 
 }  // namespace trimbot::sim
