@@ -39,4 +39,13 @@ struct WheelTicks {
   std::int64_t right = 0;
 };
 
+// An absolute pose of base_link in the map frame from a localization source (visual localization,
+// or its simulated stand-in). `stamp` is when the pose was true (the capture time of the images it
+// came from); it arrives later, after the source's processing time.
+struct PoseFix {
+  double stamp = 0.0;
+  double x = 0.0, y = 0.0, yaw = 0.0;                          // m, m, rad (map frame)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();    // of (x, y, yaw)
+};
+
 }  // namespace trimbot::messages

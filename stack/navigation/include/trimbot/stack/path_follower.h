@@ -1,0 +1,55 @@
+#pragma once
+// Path following for the differential-drive base: pure pursuit on a polyline at a cruise speed
+// (the real robot drove at ~25 cm/s). On a new path it first turns on the spot to face along it
+// (driving off on an arc would swing the front of the base, 0.7 m ahead of the axle, into the bush
+// it just reached); later it turns on the spot when the path points far away, and slows down for
+// the goal. At sharp corners of the path it stops and turns on the spot rather than cutting them.
+#include <Eigen/Core>
+#include <vector>
+
+#include "trimbot/messages/commands.h"
+#include "trimbot/stack/wheel_odometry.h"
+
+namespace trimbot::stack {
+
+struct FollowerParameters {
+  double cruise_speed = 0.25;           // m/s
+  double lookahead = 0.6;               // m along the path
+  double max_angular_speed = 0.6;       // rad/s
+  double align_tolerance = 0.15;        // rad: on a new path, turn on the spot until within this
+  double turn_in_place_above = 0.6;     // rad: heading errors above this turn on the spot first
+  double heading_gain = 1.5;            // 1/s, for turning on the spot
+  double sharp_turn = 0.5;              // rad: path vertices turning more are driven to, not cut
+  double vertex_tolerance = 0.06;       // m: a sharp vertex counts as reached within this
+  double goal_tolerance = 0.08;         // m: arrival, judged on the pose estimate
+  double slow_down_distance = 0.6;      // m before the goal
+  double min_speed = 0.05;              // m/s near the goal
+};
+
+struct FollowerOutput {
+  messages::BaseVelocityCommand command;
+  bool arrived = false;
+  double distance_to_goal = 0.0;   // m, straight line from the estimate
+  double deviation = 0.0;          // m, from the estimate to the nearest point of the path
+};
+
+class PathFollower {
+ public:
+  explicit PathFollower(const FollowerParameters& parameters) : parameters_(parameters) {}
+
+  void SetPath(const std::vector<Eigen::Vector2d>& path);
+  FollowerOutput Update(const Pose2& pose);
+  const std::vector<Eigen::Vector2d>& path() const { return path_; }
+  const FollowerParameters& parameters() const { return parameters_; }
+
+ private:
+  FollowerParameters parameters_;
+  std::vector<Eigen::Vector2d> path_;
+  std::size_t segment_ = 0;   // progress along the path: never goes back, so loops are not cut
+  bool aligned_ = false;      // has faced along the path since it was set (or since a sharp vertex)
+
+  // Index of the first sharp vertex after `segment` (or of the goal).
+  std::size_t StretchEnd(std::size_t segment) const;
+};
+
+}  // namespace trimbot::stack

@@ -1,0 +1,116 @@
+#include "trimbot/stack/navigator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace trimbot::stack {
+
+const char* ToString(NavigationEvent::Type type) {
+  switch (type) {
+    case NavigationEvent::Type::kPlanned: return "planned";
+    case NavigationEvent::Type::kPlanFailed: return "plan_failed";
+    case NavigationEvent::Type::kGoalReached: return "goal_reached";
+    case NavigationEvent::Type::kGoalFailed: return "goal_failed";
+    case NavigationEvent::Type::kObstacleStop: return "obstacle_stop";
+    case NavigationEvent::Type::kRecovered: return "recovered";
+  }
+  return "?";
+}
+
+Navigator::Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters)
+    : map_(map), parameters_(parameters), planner_(map, parameters.planner), follower_(parameters.follower) {}
+
+void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
+  goals_ = goals;
+  goal_ = 0;
+  recoveries_ = 0;
+  plan_failures_ = 0;
+  follower_.SetPath({});
+  mode_ = goals_.empty() ? Mode::kDone : Mode::kIdle;
+}
+
+double Navigator::FootprintClearance(const Pose2& pose) const {
+  return parameters_.planner.footprint.Clearance(map_, pose.x, pose.y, pose.yaw);
+}
+
+void Navigator::Emit(double stamp, NavigationEvent::Type type, const std::string& detail) {
+  events_.push_back({stamp, type, goal_, detail});
+}
+
+std::vector<NavigationEvent> Navigator::TakeEvents() {
+  std::vector<NavigationEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+void Navigator::GiveUpGoal(double stamp, const std::string& why) {
+  Emit(stamp, NavigationEvent::Type::kGoalFailed, why);
+  follower_.SetPath({});
+  mode_ = Mode::kFailed;
+}
+
+void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
+  const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goals_[goal_], plan_failures_);
+  if (!plan.found) {
+    Emit(stamp, NavigationEvent::Type::kPlanFailed, plan.message);
+    if (++plan_failures_ >= parameters_.max_plan_failures) GiveUpGoal(stamp, "no path: " + plan.message);
+    return;
+  }
+  follower_.SetPath(plan.path);
+  mode_ = Mode::kFollowing;
+  Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m");
+}
+
+messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estimate) {
+  messages::BaseVelocityCommand stop;
+  if (mode_ == Mode::kDone || mode_ == Mode::kFailed) return stop;
+
+  if (mode_ == Mode::kIdle) {
+    PlanToCurrentGoal(stamp, estimate);
+    if (mode_ != Mode::kFollowing) return stop;
+  }
+
+  if (mode_ == Mode::kBackingOff) {
+    // Straight back until the footprint is clear again (or the back-off distance is used up).
+    const double moved = (Eigen::Vector2d(estimate.x, estimate.y) - backoff_start_).norm();
+    if (FootprintClearance(estimate) >= parameters_.resume_clearance || moved >= parameters_.max_backoff) {
+      Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
+      mode_ = Mode::kIdle;
+      return stop;  // plan on the next update, from where the robot stopped
+    }
+    messages::BaseVelocityCommand back;
+    back.linear = -parameters_.backoff_speed;
+    return back;
+  }
+
+  // Following.
+  const FollowerOutput follow = follower_.Update(estimate);
+  if (follow.arrived) {
+    Emit(stamp, NavigationEvent::Type::kGoalReached);
+    ++goal_;
+    recoveries_ = 0;
+    plan_failures_ = 0;
+    follower_.SetPath({});
+    mode_ = goal_ < static_cast<int>(goals_.size()) ? Mode::kIdle : Mode::kDone;
+    return stop;
+  }
+  // Too close to an obstacle of the map while moving towards it: stop and back off.
+  if (FootprintClearance(estimate) < parameters_.stop_clearance && follow.command.linear > 0.0) {
+    Emit(stamp, NavigationEvent::Type::kObstacleStop);
+    if (++recoveries_ > parameters_.max_recoveries_per_goal) {
+      GiveUpGoal(stamp, "too many recoveries");
+      return stop;
+    }
+    backoff_start_ = {estimate.x, estimate.y};
+    mode_ = Mode::kBackingOff;
+    return stop;
+  }
+  if (follow.deviation > parameters_.replan_deviation) {
+    mode_ = Mode::kIdle;
+    return stop;
+  }
+  return follow.command;
+}
+
+}  // namespace trimbot::stack

@@ -1,0 +1,187 @@
+// The robot's navigation on its prior map: occupancy grid and distances, OMPL planning around
+// obstacles, path following on a simulated unicycle, goal-to-goal navigation with the obstacle stop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "trimbot/common/input_error.h"
+#include "trimbot/stack/global_planner.h"
+#include "trimbot/stack/navigator.h"
+#include "trimbot/stack/occupancy_grid.h"
+#include "trimbot/stack/path_follower.h"
+
+namespace trimbot::stack {
+namespace {
+
+// 10 x 8 m map at 5 cm, origin (0, 0), with a wall x in [4.8, 5.2], y in [0, 6] (a gap above y = 6).
+OccupancyGrid WallMap() {
+  const double resolution = 0.05;
+  cv::Mat occupied(160, 200, CV_8U, cv::Scalar(0));
+  for (int r = 0; r < occupied.rows; ++r) {
+    for (int c = 0; c < occupied.cols; ++c) {
+      const double x = (c + 0.5) * resolution, y = (occupied.rows - 1 - r + 0.5) * resolution;
+      if (x > 4.8 && x < 5.2 && y < 6.0) occupied.at<uchar>(r, c) = 255;
+    }
+  }
+  return OccupancyGrid(occupied, resolution, {0.0, 0.0});
+}
+
+// A differential-drive base that does exactly what it is told.
+Pose2 Integrate(const Pose2& pose, const messages::BaseVelocityCommand& command, double dt) {
+  Pose2 next = pose;
+  next.x += command.linear * std::cos(pose.yaw) * dt;
+  next.y += command.linear * std::sin(pose.yaw) * dt;
+  next.yaw = std::remainder(pose.yaw + command.angular * dt, 2.0 * M_PI);
+  return next;
+}
+
+TEST(OccupancyGrid, DistanceToTheNearestObstacle) {
+  const OccupancyGrid map = WallMap();
+  EXPECT_NEAR(map.DistanceToObstacle({3.8, 3.0}), 1.0, 0.04);
+  EXPECT_NEAR(map.DistanceToObstacle({6.2, 2.0}), 1.0, 0.04);
+  EXPECT_EQ(map.DistanceToObstacle({5.0, 3.0}), 0.0);
+  EXPECT_EQ(map.DistanceToObstacle({-1.0, 3.0}), 0.0) << "outside the map counts as occupied";
+  const cv::Point cell = map.Cell({5.0, 3.0});
+  EXPECT_NEAR(map.CellCentre(cell).x(), 5.0, 0.03);
+  EXPECT_NEAR(map.CellCentre(cell).y(), 3.0, 0.03);
+}
+
+TEST(OccupancyGrid, LoadsMapServerFilesAndNamesTheFileOnErrors) {
+  const std::string dir = ::testing::TempDir() + "/map_server_test";
+  std::filesystem::create_directories(dir);
+  cv::Mat image(40, 60, CV_8U, cv::Scalar(254));
+  image(cv::Rect(10, 10, 5, 5)).setTo(0);  // black = occupied
+  cv::imwrite(dir + "/m.png", image);
+  std::ofstream(dir + "/m.yaml") << "image: m.png\nresolution: 0.1\norigin: [-1.0, -2.0, 0.0]\nnegate: 0\n"
+                                    "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  const OccupancyGrid map = OccupancyGrid::LoadMapServer(dir + "/m.yaml");
+  EXPECT_EQ(map.occupied().cols, 60);
+  EXPECT_NEAR(map.origin().y(), -2.0, 1e-12);
+  // Cell (12, 12) from the top is occupied: x = -1 + 1.25, y = -2 + (40 - 12.5) * 0.1.
+  EXPECT_EQ(map.DistanceToObstacle({0.25, 0.75}), 0.0);
+  EXPECT_GT(map.DistanceToObstacle({4.0, 1.5}), 2.0);
+
+  std::ofstream(dir + "/bad.yaml") << "image: missing.png\nresolution: 0.1\norigin: [0, 0, 0]\n";
+  try {
+    OccupancyGrid::LoadMapServer(dir + "/bad.yaml");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.png"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir + "/typo.yaml") << "image: m.png\nresolution: 0.1\norigin: [0, 0, 0]\nresolutoin: 2\n";
+  try {
+    OccupancyGrid::LoadMapServer(dir + "/typo.yaml");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("typo.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("resolutoin"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GlobalPlanner, PlansAroundAWallKeepingTheClearance) {
+  SeedPlanner(7);
+  const OccupancyGrid map = WallMap();
+  const GlobalPlanner planner(map, PlannerParameters{});
+  const PlanResult plan = planner.Plan({2.0, 2.0}, {8.0, 2.0});
+  ASSERT_TRUE(plan.found) << plan.message;
+  EXPECT_NEAR((plan.path.front() - Eigen::Vector2d(2.0, 2.0)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((plan.path.back() - Eigen::Vector2d(8.0, 2.0)).norm(), 0.0, 0.05);
+  // Around the end of the wall at y = 6 and back: at least 2 * hypot(3, 4.5) long.
+  EXPECT_GT(plan.length, 2.0 * std::hypot(3.0, 4.0));
+  EXPECT_LT(plan.length, 13.0) << "a detour far beyond the gap";
+  bool went_over_the_wall = false;
+  for (std::size_t i = 1; i < plan.path.size(); ++i) {
+    for (double f = 0.0; f <= 1.0; f += 0.02) {
+      const Eigen::Vector2d p = plan.path[i - 1] + f * (plan.path[i] - plan.path[i - 1]);
+      EXPECT_GE(map.DistanceToObstacle(p), planner.parameters().robot_radius - 0.03) << p.transpose();
+      went_over_the_wall = went_over_the_wall || (std::abs(p.x() - 5.0) < 0.3 && p.y() > 6.0);
+    }
+  }
+  EXPECT_TRUE(went_over_the_wall);
+}
+
+TEST(GlobalPlanner, ReportsUnreachableAndBlockedGoals) {
+  SeedPlanner(7);
+  cv::Mat occupied(100, 100, CV_8U, cv::Scalar(0));
+  cv::rectangle(occupied, cv::Rect(60, 20, 30, 30), cv::Scalar(255), 2);  // a closed box
+  const OccupancyGrid map(occupied, 0.05, {0.0, 0.0});
+  PlannerParameters parameters;
+  parameters.iterations = 500;
+  const GlobalPlanner planner(map, parameters);
+  const Eigen::Vector2d inside_box(3.75, 3.25);
+  ASSERT_TRUE(planner.Free(inside_box));
+  const PlanResult enclosed = planner.Plan({1.0, 1.0}, inside_box);
+  EXPECT_FALSE(enclosed.found);
+  EXPECT_FALSE(enclosed.message.empty());
+  const PlanResult on_wall = planner.Plan({1.0, 1.0}, {3.0, 2.5});
+  EXPECT_FALSE(on_wall.found);
+  EXPECT_NE(on_wall.message.find("goal"), std::string::npos) << on_wall.message;
+}
+
+TEST(PathFollower, DrivesAnLShapedPathTurningOnTheSpotAtTheCorner) {
+  PathFollower follower(FollowerParameters{});
+  follower.SetPath({{0.0, 0.0}, {3.0, 0.0}, {3.0, 2.0}});
+  Pose2 pose{0.0, 0.0, 0.0};
+  double worst_deviation = 0.0, top_speed = 0.0;
+  bool arrived = false;
+  for (int k = 0; k < 4000 && !arrived; ++k) {
+    const FollowerOutput out = follower.Update(pose);
+    arrived = out.arrived;
+    worst_deviation = std::max(worst_deviation, out.deviation);
+    top_speed = std::max(top_speed, out.command.linear);
+    pose = Integrate(pose, out.command, 0.05);
+  }
+  ASSERT_TRUE(arrived);
+  EXPECT_LT(std::hypot(pose.x - 3.0, pose.y - 2.0), 0.08);
+  // Within the sharp-vertex tolerance of the path everywhere: a cut corner would be ~0.2 m off.
+  EXPECT_LT(worst_deviation, FollowerParameters{}.vertex_tolerance + 0.01) << "the corner was cut";
+  EXPECT_NEAR(top_speed, 0.25, 1e-9);
+}
+
+TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
+  SeedPlanner(11);
+  const OccupancyGrid map = WallMap();
+  Navigator navigator(map, NavigatorParameters{});
+  navigator.SetGoals({{8.0, 2.0}, {2.0, 1.5}});
+  Pose2 pose{2.0, 2.0, M_PI / 2};
+  std::vector<NavigationEvent> events;
+  double t = 0.0;
+  double closest = 1e9;
+  for (; t < 400.0 && navigator.mode() != Navigator::Mode::kDone; t += 0.05) {
+    pose = Integrate(pose, navigator.Update(t, pose), 0.05);
+    closest = std::min(closest, navigator.FootprintClearance(pose));
+    for (const auto& e : navigator.TakeEvents()) events.push_back(e);
+  }
+  ASSERT_EQ(navigator.mode(), Navigator::Mode::kDone);
+  int reached = 0;
+  for (const auto& e : events) reached += e.type == NavigationEvent::Type::kGoalReached ? 1 : 0;
+  EXPECT_EQ(reached, 2);
+  EXPECT_LT(std::hypot(pose.x - 2.0, pose.y - 1.5), 0.1);
+  EXPECT_GT(closest, 0.03) << "the footprint came closer to the wall than the stop distance";
+
+  // Driving north along the wall, 0.5 m from it, the estimate jumps 0.25 m towards the wall (a
+  // re-localization): the footprint is now within the stop distance while moving - stop, back off.
+  Navigator stopper(map, NavigatorParameters{});
+  stopper.SetGoals({{4.3, 5.5}});
+  Pose2 truth{4.3, 1.0, M_PI / 2};
+  bool stopped = false, backed = false;
+  for (int k = 0; k < 400 && !backed; ++k) {
+    Pose2 estimate = truth;
+    if (k >= 100) estimate.x += 0.25;
+    const auto command = stopper.Update(k * 0.05, estimate);
+    for (const auto& e : stopper.TakeEvents()) stopped = stopped || e.type == NavigationEvent::Type::kObstacleStop;
+    backed = command.linear < 0.0;
+    EXPECT_FALSE(k < 100 && stopped) << "stopped before the jump";
+    truth = Integrate(truth, command, 0.05);
+  }
+  EXPECT_TRUE(stopped);
+  EXPECT_TRUE(backed);
+}
+
+}  // namespace
+}  // namespace trimbot::stack
