@@ -1,8 +1,15 @@
 #!/usr/bin/env bash
-# The main job: set up (packages + build), then drive the robot headless in a garden.
-# PLAN picks the drive plan (default: the Wageningen test garden tour); OUT_DIR the output folder.
-# Outputs (ring images, depth, labels, IMU/odometry logs, ground truth, summary) go to out/drive/.
+# The main job: set up (packages + build), then run the rectangle navigation trials of the real
+# robot headless in the Wageningen garden twin (6 trials, closed loop) -> out/rectangle/.
+#   SCENARIO=scenarios/navigation/hourglass.yaml scripts/run_main.sh   another scenario
+#   PLAN=scenarios/drives/wageningen_tour.yaml scripts/run_main.sh     an open-loop drive that
+#                                                                      records the camera ring
+# OUT_DIR sets the output folder; further arguments go to trimbot. Exit code 1: a criterion failed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-build/bin/trimbot drive "${PLAN:-scenarios/drives/wageningen_tour.yaml}" --out "${OUT_DIR:-out/drive}" "$@"
+if [ -n "${PLAN:-}" ]; then
+  exec build/bin/trimbot drive "$PLAN" --out "${OUT_DIR:-out/drive}" "$@"
+fi
+SCENARIO="${SCENARIO:-scenarios/navigation/rectangle.yaml}"
+exec build/bin/trimbot run "$SCENARIO" --out "${OUT_DIR:-out/$(basename "$SCENARIO" .yaml)}" --jobs 2 "$@"

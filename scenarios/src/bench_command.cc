@@ -17,12 +17,8 @@ using Clock = std::chrono::steady_clock;
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
 sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4) {
-  sim::SimulatorConfig config;
-  config.urdf_path = options.paths.urdf();
-  config.calibration_path = options.paths.nominal_calibration();
-  config.robot_parameters_path = options.paths.robot_parameters();
-  config.garden_path = garden::Garden::Resolve(options.garden, options.paths.gardens_dir());
-  config.world_dir = std::filesystem::temp_directory_path().string() + "/trimbot_bench_world";
+  sim::SimulatorConfig config = options.paths.SimulatorConfigFor(
+      options.garden, std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
   config.seed = 7;
   config.render_cameras = cameras;
   config.resolution_scale = scale;

@@ -50,13 +50,8 @@ int RunDrive(const DriveOptions& options) {
   const std::string out = options.output_dir;
   fs::create_directories(out);
 
-  sim::SimulatorConfig config;
-  config.urdf_path = options.paths.urdf();
-  config.calibration_path =
-      options.calibration_path.empty() ? options.paths.nominal_calibration() : options.calibration_path;
-  config.robot_parameters_path = options.paths.robot_parameters();
-  config.garden_path = garden::Garden::Resolve(plan.garden, options.paths.gardens_dir());
-  config.world_dir = out + "/world";
+  sim::SimulatorConfig config = options.paths.SimulatorConfigFor(plan.garden, out + "/world");
+  if (!options.calibration_path.empty()) config.calibration_path = options.calibration_path;
   config.seed = options.seed.value_or(plan.seed);
   config.start = plan.start;
   config.conditions = plan.conditions;

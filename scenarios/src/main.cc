@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "batch_command.h"
 #include "bench_command.h"
 #include "drive_command.h"
 #include "garden_command.h"
@@ -40,6 +41,8 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--drive-seconds", bench.drive_seconds, "simulated seconds of the drive measurement");
 
   AddGardenCommands(app, data_root);
+  int exit_code = 0;
+  AddBatchCommands(app, data_root, exit_code);
 
   try {
     try {
@@ -58,7 +61,7 @@ int main(int argc, char** argv) {
       bench.paths = {data_root};
       return RunBench(bench);
     }
-    return 0;
+    return exit_code;
   } catch (const trimbot::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

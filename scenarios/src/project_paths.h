@@ -3,6 +3,8 @@
 // source tree the binary was built from; --data-root points elsewhere (e.g. an installed copy).
 #include <string>
 
+#include "trimbot/sim/simulator.h"
+
 namespace trimbot::scenarios {
 
 struct ProjectPaths {
@@ -14,6 +16,10 @@ struct ProjectPaths {
   std::string gardens_dir() const { return root + "/garden_scenes/gardens"; }
 
   static ProjectPaths Default();
+
+  // A simulator configuration with the project's robot (URDF, nominal calibration, parameters)
+  // in `garden` (name or file), composing its world in `world_dir`; the rest at defaults.
+  sim::SimulatorConfig SimulatorConfigFor(const std::string& garden, const std::string& world_dir) const;
 };
 
 }  // namespace trimbot::scenarios

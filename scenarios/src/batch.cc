@@ -1,0 +1,355 @@
+#include "batch.h"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "batch_report.h"
+#include "scenario.h"
+#include "trial.h"
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/garden/garden.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/stack/global_planner.h"
+#include "trimbot/stack/occupancy_grid.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+// What a run was asked to do; written as batch.json, read back by merge.
+struct BatchInfo {
+  std::string scenario_file;   // the copy in the output folder is scenario.yaml
+  std::uint64_t seed = 0;
+  int trials = 0;
+  int shard_index = 0, shard_count = 1;
+};
+
+json ToJson(const BatchInfo& info) {
+  return {{"scenario_file", info.scenario_file}, {"seed", info.seed}, {"trials", info.trials},
+          {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)}};
+}
+
+BatchInfo ReadBatchInfo(const std::string& dir) {
+  const std::string path = dir + "/batch.json";
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "not found: is " + dir + " the output folder of `trimbot run`?");
+  try {
+    const json j = json::parse(in);
+    BatchInfo info;
+    info.scenario_file = j.at("scenario_file").get<std::string>();
+    info.seed = j.at("seed").get<std::uint64_t>();
+    info.trials = j.at("trials").get<int>();
+    std::tie(info.shard_index, info.shard_count) = ParseShard(j.at("shard").get<std::string>(), path);
+    return info;
+  } catch (const json::exception& e) {
+    throw InputError(path, std::string("malformed: ") + e.what());
+  }
+}
+
+std::string TrialDir(const std::string& out, int index) {
+  std::ostringstream name;
+  name << out << "/trials/" << std::setw(3) << std::setfill('0') << index;
+  return name.str();
+}
+
+TrialResult Unfinished(int index, std::uint64_t seed, const std::string& status, const std::string& message) {
+  TrialResult result;
+  result.index = index;
+  result.seed = seed;
+  result.status = status;
+  result.message = message;
+  return result;
+}
+
+// The result a trial process left, or nullopt when it left none (or a broken one).
+std::optional<TrialResult> ReadTrialResult(const std::string& dir) {
+  std::ifstream in(dir + "/result.json");
+  if (!in) return std::nullopt;
+  try {
+    return json::parse(in).get<TrialResult>();
+  } catch (const json::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::string OneLine(const TrialResult& r) {
+  int reached = 0;
+  for (const auto& g : r.goals) reached += g.reached ? 1 : 0;
+  std::ostringstream line;
+  line << std::fixed << std::setprecision(1) << "trial " << std::setw(3) << std::setfill('0') << r.index
+       << std::setfill(' ') << " seed " << r.seed << ": " << (r.success ? "success" : "FAILED") << " (" << r.status
+       << (r.message.empty() ? "" : ": " + r.message) << "), goals " << reached << "/" << r.goals.size() << ", "
+       << r.simulated_seconds << " s simulated, " << r.wall_seconds << " s wall";
+  for (const auto& e : r.estimates) {
+    if (e.name == "ekf" && !e.position_m.empty()) {
+      line << std::setprecision(3) << ", EKF error mean " << e.position().mean << " m";
+    }
+  }
+  if (r.collisions > 0) line << ", " << r.collisions << " collisions";
+  return line.str();
+}
+
+// Summary, JUnit and plots of a set of trial results; returns the exit code.
+int WriteReports(const std::string& out, const Scenario& scenario, const BatchInfo& info,
+                 std::vector<TrialResult> results, int trials_planned) {
+  std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
+  BatchSummary summary;
+  summary.scenario = scenario.name;
+  summary.scenario_file = info.scenario_file;
+  summary.seed = info.seed;
+  summary.trials_planned = trials_planned;
+  summary.trials = results;
+  summary.metrics = ComputeBatchMetrics(results, trials_planned);
+  summary.pass = true;
+  for (const auto& criterion : scenario.criteria) {
+    CriterionResult c;
+    c.name = criterion.metric;
+    c.comparison = criterion.comparison;
+    c.expected = criterion.threshold;
+    const bool measured = summary.metrics.contains(criterion.metric);
+    c.actual = measured ? summary.metrics.at(criterion.metric).get<double>() : std::nan("");
+    c.pass = measured && (criterion.comparison == ">=" ? c.actual >= c.expected : c.actual <= c.expected);
+    summary.pass = summary.pass && c.pass;
+    summary.criteria.push_back(c);
+  }
+  WriteFileAtomically(out + "/summary.json", json(summary).dump(2));
+  WriteJunitXml(out + "/junit.xml", summary);
+
+  const stack::OccupancyGrid map = stack::OccupancyGrid::LoadMapServer(out + "/map/map.yaml");
+  std::vector<PlotTrajectory> trajectories;
+  for (const auto& r : results) {
+    const std::string dir = TrialDir(out, r.index);
+    if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
+    trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
+  }
+  WriteTrajectoryPlot(out + "/trajectories.png", map, trajectories, scenario.goals,
+                      scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
+  WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
+
+  std::cout << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
+  for (const auto& r : results) std::cout << "  " << OneLine(r) << "\n";
+  std::cout << "criteria:\n";
+  for (const auto& c : summary.criteria) {
+    std::cout << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
+              << " (actual " << c.actual << ")\n";
+  }
+  std::cout << "outputs in " << out << " (summary.json, junit.xml, trajectories.png, localization_errors.png)\n";
+  return summary.pass ? 0 : 1;
+}
+
+struct RunningTrial {
+  pid_t pid = 0;
+  int index = 0;
+  std::uint64_t seed = 0;
+  std::string dir;
+  Clock::time_point started;
+};
+
+// Body of a trial's child process. Never returns.
+[[noreturn]] void RunTrialProcess(const TrialSetup& setup) {
+  int code = 0;
+  try {
+    stack::SeedPlanner(static_cast<std::uint32_t>(setup.seed & 0xffffffffu));
+    RunTrial(setup, [&](double t) {
+      std::ofstream(setup.dir + "/progress") << t << "\n";
+    });
+  } catch (const std::exception& e) {
+    TrialResult result = Unfinished(setup.index, setup.seed, "error", e.what());
+    try {
+      WriteFileAtomically(setup.dir + "/result.json", json(result).dump(2));
+    } catch (...) {
+    }
+    code = 3;
+  }
+  std::fflush(nullptr);
+  _exit(code);
+}
+
+double ReadProgress(const std::string& dir) {
+  double t = 0.0;
+  std::ifstream(dir + "/progress") >> t;
+  return t;
+}
+
+}  // namespace
+
+std::pair<int, int> ParseShard(const std::string& text, const std::string& what) {
+  int i = -1, n = 0;
+  char slash = 0;
+  std::istringstream in(text);
+  if (!(in >> i >> slash >> n) || slash != '/' || !in.eof() || n < 1 || i < 0 || i >= n) {
+    throw InputError(what, "shard '" + text + "' is not i/n with 0 <= i < n");
+  }
+  return {i, n};
+}
+
+int RunBatch(const BatchOptions& options) {
+  const Scenario scenario = Scenario::Load(options.scenario_path);
+  const std::string& out = options.out_dir;
+  BatchInfo info;
+  info.scenario_file = fs::absolute(options.scenario_path).string();
+  info.seed = options.seed.value_or(scenario.seed);
+  info.trials = options.trials.value_or(scenario.trials);
+  info.shard_index = options.shard_index;
+  info.shard_count = options.shard_count;
+  if (info.trials < 1) throw InputError(options.scenario_path, "--trials must be at least 1");
+  if (options.jobs < 1) throw InputError(options.scenario_path, "--jobs must be at least 1");
+
+  fs::create_directories(out);
+  WriteFileAtomically(out + "/batch.json", ToJson(info).dump(2));
+  {
+    std::ifstream in(options.scenario_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    WriteFileAtomically(out + "/scenario.yaml", text.str());
+  }
+  // The robot's prior map, from the garden's object map (as the real robot's sketch map).
+  const garden::Garden garden = garden::Garden::Load(garden::Garden::Resolve(scenario.garden, options.paths.gardens_dir()));
+  garden::WriteOccupancyMap(garden::MakeOccupancyMap(garden, scenario.map_resolution, scenario.map_clearance_height),
+                            out + "/map", "map");
+
+  std::vector<int> queue;
+  for (int i = 0; i < info.trials; ++i) {
+    if (i % info.shard_count == info.shard_index) queue.push_back(i);
+  }
+  const int planned = static_cast<int>(queue.size());
+  std::reverse(queue.begin(), queue.end());  // pop from the back in index order
+
+  const bool interactive = isatty(STDOUT_FILENO) != 0;
+  std::cout << "[run] " << scenario.name << ": " << planned << " trials (shard " << info.shard_index << "/"
+            << info.shard_count << ", seeds " << info.seed << "+i), " << options.jobs << " at a time -> " << out
+            << std::endl;
+  const auto batch_start = Clock::now();
+  std::vector<RunningTrial> running;
+  std::vector<TrialResult> results;
+  auto finish = [&](const TrialResult& result) {
+    results.push_back(result);
+    if (interactive) std::cout << "\r\033[K";
+    std::cout << "[run] " << OneLine(results.back()) << std::endl;
+  };
+
+  while (!queue.empty() || !running.empty()) {
+    while (static_cast<int>(running.size()) < options.jobs && !queue.empty()) {
+      RunningTrial trial;
+      trial.index = queue.back();
+      queue.pop_back();
+      trial.seed = info.seed + static_cast<std::uint64_t>(trial.index);
+      trial.dir = TrialDir(out, trial.index);
+      fs::remove_all(trial.dir);
+      fs::create_directories(trial.dir);
+      TrialSetup setup{&scenario, options.paths, out + "/map/map.yaml", trial.dir, trial.index, trial.seed};
+      std::cout.flush();
+      trial.started = Clock::now();
+      trial.pid = fork();
+      if (trial.pid < 0) throw std::runtime_error("fork failed");
+      if (trial.pid == 0) RunTrialProcess(setup);
+      running.push_back(trial);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    for (auto it = running.begin(); it != running.end();) {
+      int status = 0;
+      const pid_t done = waitpid(it->pid, &status, WNOHANG);
+      const double wall = std::chrono::duration<double>(Clock::now() - it->started).count();
+      std::optional<TrialResult> result;
+      if (done == it->pid) {
+        result = ReadTrialResult(it->dir);
+        if (WIFSIGNALED(status)) {
+          result = Unfinished(it->index, it->seed, "crashed", "killed by signal " + std::to_string(WTERMSIG(status)) +
+                                                                   " (" + strsignal(WTERMSIG(status)) + ")");
+        } else if (!result) {
+          result = Unfinished(it->index, it->seed, "crashed", "exited with code " + std::to_string(WEXITSTATUS(status)) +
+                                                                  " without a result");
+        }
+      } else if (wall > scenario.wall_time_limit) {
+        kill(it->pid, SIGKILL);
+        waitpid(it->pid, &status, 0);
+        result = Unfinished(it->index, it->seed, "timeout",
+                            "killed after the wall-clock limit of " + std::to_string(scenario.wall_time_limit) + " s");
+      }
+      if (!result) {
+        ++it;
+        continue;
+      }
+      result->wall_seconds = wall;
+      if (result->goals.empty()) {
+        for (const auto& goal : scenario.goals) result->goals.push_back({goal.x(), goal.y()});
+      }
+      if (result->status == "crashed" || result->status == "timeout") {
+        WriteFileAtomically(it->dir + "/result.json", json(*result).dump(2));
+      }
+      if (!options.keep_worlds) fs::remove_all(it->dir + "/world");
+      fs::remove(it->dir + "/progress");
+      finish(*result);
+      it = running.erase(it);
+    }
+    if (interactive && !running.empty()) {
+      std::ostringstream line;
+      line << "\r\033[K[run] " << results.size() << "/" << planned << " done |";
+      for (const auto& trial : running) {
+        line << " trial " << trial.index << ": " << std::fixed << std::setprecision(0) << ReadProgress(trial.dir)
+             << "/" << scenario.time_limit << " s";
+      }
+      line << " | " << std::setprecision(0)
+           << std::chrono::duration<double>(Clock::now() - batch_start).count() << " s elapsed";
+      std::cout << line.str() << std::flush;
+    }
+  }
+  return WriteReports(out, scenario, info, results, planned);
+}
+
+int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir) {
+  if (shard_dirs.empty()) throw InputError(out_dir, "merge needs at least one shard folder");
+  std::optional<BatchInfo> batch;
+  std::map<int, TrialResult> results;
+  fs::create_directories(out_dir + "/trials");
+  for (const auto& dir : shard_dirs) {
+    const BatchInfo info = ReadBatchInfo(dir);
+    if (!batch) {
+      batch = info;
+      fs::copy(dir + "/scenario.yaml", out_dir + "/scenario.yaml", fs::copy_options::overwrite_existing);
+      fs::create_directories(out_dir + "/map");
+      fs::copy(dir + "/map", out_dir + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+    } else if (info.seed != batch->seed || info.trials != batch->trials || info.shard_count != batch->shard_count) {
+      throw InputError(dir + "/batch.json", "belongs to another batch (seed, trials or shard count differ from " +
+                                                 shard_dirs.front() + ")");
+    }
+    for (int i = info.shard_index; i < info.trials; i += info.shard_count) {
+      const std::string trial_dir = TrialDir(dir, i);
+      std::optional<TrialResult> result = ReadTrialResult(trial_dir);
+      if (!result) continue;
+      fs::copy(trial_dir, TrialDir(out_dir, i), fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+      results[i] = *result;
+    }
+  }
+  BatchInfo merged = *batch;
+  merged.shard_index = 0;
+  merged.shard_count = 1;
+  WriteFileAtomically(out_dir + "/batch.json", ToJson(merged).dump(2));
+  std::vector<TrialResult> all;
+  for (int i = 0; i < merged.trials; ++i) {
+    all.push_back(results.count(i) ? results[i]
+                                   : Unfinished(i, merged.seed + i, "not run", "no result in the merged shards"));
+  }
+  const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
+  return WriteReports(out_dir, scenario, merged, all, merged.trials);
+}
+
+}  // namespace trimbot::scenarios
