@@ -6,7 +6,10 @@
 #include "batch_command.h"
 #include "bench_command.h"
 #include "drive_command.h"
+#include "fusion_command.h"
 #include "garden_command.h"
+#include "registration_command.h"
+#include "stereo_command.h"
 #include "trimbot/common/input_error.h"
 
 int main(int argc, char** argv) {
@@ -43,6 +46,9 @@ int main(int argc, char** argv) {
   AddGardenCommands(app, data_root);
   int exit_code = 0;
   AddBatchCommands(app, data_root, exit_code);
+  AddRegistrationCommand(app, exit_code);
+  AddFusionCommand(app, data_root, exit_code);
+  AddStereoCommand(app, data_root);
 
   try {
     try {

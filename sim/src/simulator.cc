@@ -183,7 +183,7 @@ void Simulator::Step(StepOutputs* outputs) {
   if (impl_->step % impl_->encoder_steps == 0) outputs->wheel_ticks.push_back(impl_->encoders->Read(d->time));
 
   if (cameras_available && impl_->step % impl_->camera_steps == 0) {
-    if (impl_->renderer) {
+    if (impl_->renderer && config_.cameras_on_schedule) {
       const int every = config_.ground_truth_every_frames;
       outputs->ring = CaptureRing(every > 0 && impl_->frame % every == 0);
     }

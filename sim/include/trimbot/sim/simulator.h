@@ -39,6 +39,7 @@ struct SimulatorConfig {
   Pose2D start;
   double timestep = 0.0025;          // s
   bool render_cameras = true;
+  bool cameras_on_schedule = true;   // false: the ring renders only when CaptureRing is called
   int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
   double resolution_scale = 1.0;     // 0.5 renders half-resolution images
   int msaa_samples = 4;              // anti-aliasing; 0 halves the render time, edges get jagged

@@ -1,0 +1,68 @@
+#pragma once
+// Rigid registration of two point clouds that carry per-point uncertainty: find R, t with
+// x ~ R y + t (the source cloud Y moved onto the target cloud X).
+//
+// DUGMA (Dynamic Uncertainty-based Gaussian Mixture Alignment, reference deliverable D3.4
+// section 1) as EM: the E-step weighs every pair (x_i, y_j) by the Gaussian of their difference
+// under both points' covariances, Sigma_x + R Sigma_y R^T, normalized per source point against an
+// outlier term; the M-step finds R, t minimizing the weighted Mahalanobis distances (closed form
+// when all covariances are isotropic, a Gauss-Newton step otherwise). Pairs beyond
+// `truncation_sigmas` are negligible and never formed: each source point only meets its k nearest
+// target points (k-d tree), so the cost is near-linear in the cloud sizes instead of N x M. An
+// annealing term (an isotropic spread added to every pair, shrinking each iteration) widens the
+// basin at the start - the "dynamic" part.
+//
+// ICP (point-to-point, nearest neighbour, annealed rejection distance) is the baseline through the
+// same API.
+#include <Eigen/Geometry>
+#include <stdexcept>
+#include <string>
+
+#include "trimbot/perception/point_cloud.h"
+
+namespace trimbot::perception {
+
+enum class RegistrationMethod { kDugma, kIcp };
+
+struct RegistrationOptions {
+  RegistrationMethod method = RegistrationMethod::kDugma;
+  int max_iterations = 100;
+  double tolerance = 1e-5;          // rad + m: stop when an iteration moves less than this
+  int neighbours = 10;              // k nearest target points per source point
+  int max_source_points = 10000;    // DUGMA uses at most this many source points (0: all)
+  double truncation_sigmas = 3.0;   // pairs farther apart (Mahalanobis) are left out
+  double outlier_weight = 0.1;      // relative weight of the outlier term in the E-step
+  // Annealing: initial extra spread (m); < 0 picks it from the initial misalignment (the median
+  // distance of the source points to their nearest target point) and the size of the target
+  // (30 % of its RMS radius), whichever is larger.
+  double anneal_start = -1.0;
+  double anneal_factor = 0.9;       // per iteration
+  // Covariances given as relative weights (as in the DUGMA Kinect data set) are scaled so that
+  // the median point variance equals the squared median point spacing of the target.
+  bool relative_covariances = false;
+  double max_variance = 1e4;        // m^2 (or relative units); larger marks an unusable point
+};
+
+struct RegistrationResult {
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // x = transform * y
+  int iterations = 0;
+  bool converged = false;
+  double final_cost = 0.0;          // weighted mean squared Mahalanobis distance of the pairs
+  int pairs = 0;                    // pairs with weight in the last E-step
+  CleanReport target_points, source_points;  // what was usable / dropped
+};
+
+// Bad input that leaves nothing to register (e.g. an empty cloud after dropping unusable points).
+class RegistrationError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+RegistrationResult Register(const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
+                            const RegistrationOptions& options = {});
+
+// Geodesic rotation error in degrees and translation error in metres of `estimate` against `truth`.
+double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
+double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
+
+}  // namespace trimbot::perception

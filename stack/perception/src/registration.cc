@@ -1,0 +1,357 @@
+#include "trimbot/perception/registration.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/SVD>
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+namespace trimbot::perception {
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// nanoflann adaptor over a vector of points.
+struct PointsAdaptor {
+  const std::vector<Eigen::Vector3d>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][static_cast<int>(dim)]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
+};
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 3,
+                                                   std::uint32_t>;
+
+// The target at one resolution: while the annealing spread is wide, the E-step meets a coarser
+// version of the target, so its k nearest points still cover a few spreads (a fixed k on the full
+// cloud would see only a few centimetres around each point and lose the wide basin).
+struct TargetLevel {
+  double voxel = 0.0;  // m, 0 for the full cloud
+  PointCloud cloud;
+  std::unique_ptr<PointsAdaptor> adaptor;
+  std::unique_ptr<KdTree> tree;
+
+  void Build() {
+    adaptor = std::make_unique<PointsAdaptor>(PointsAdaptor{cloud.points});
+    tree = std::make_unique<KdTree>(3, *adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree->buildIndex();
+  }
+};
+
+// One point per voxel (the first in input order, so the result is deterministic), its covariance
+// widened by the voxel's own spread.
+PointCloud VoxelDownsample(const PointCloud& cloud, double voxel) {
+  std::unordered_map<std::int64_t, bool> taken;
+  PointCloud out;
+  const Eigen::Matrix3d widen = (voxel * voxel / 12.0) * Eigen::Matrix3d::Identity();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d& p = cloud.points[i];
+    const std::int64_t key = (static_cast<std::int64_t>(std::floor(p.x() / voxel)) & 0x1fffff) |
+                             ((static_cast<std::int64_t>(std::floor(p.y() / voxel)) & 0x1fffff) << 21) |
+                             ((static_cast<std::int64_t>(std::floor(p.z() / voxel)) & 0x1fffff) << 42);
+    if (taken.emplace(key, true).second) out.Add(p, cloud.covariances[i] + widen);
+  }
+  return out;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+bool IsIsotropic(const Eigen::Matrix3d& c) {
+  const double scale = c.trace() / 3.0;
+  return (c - scale * Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-9 * std::max(scale, 1e-300);
+}
+
+// Per source point, what the E-step found: for the closed-form M-step the summed weight and the
+// weighted sum of its targets; for the Gauss-Newton step its normal-equation terms.
+struct SourceTerms {
+  double weight = 0.0;
+  Eigen::Vector3d weighted_target = Eigen::Vector3d::Zero();
+  Matrix6 H = Matrix6::Zero();
+  Vector6 g = Vector6::Zero();
+  double cost = 0.0;
+  int pairs = 0;
+};
+
+// argmin over R, t of sum_j w_j |xbar_j - R y_j - t|^2 with xbar_j = weighted_target_j / w_j.
+Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const std::vector<Eigen::Vector3d>& y) {
+  double total = 0.0;
+  Eigen::Vector3d sum_x = Eigen::Vector3d::Zero(), sum_y = Eigen::Vector3d::Zero();
+  for (std::size_t j = 0; j < y.size(); ++j) {
+    total += terms[j].weight;
+    sum_x += terms[j].weighted_target;
+    sum_y += terms[j].weight * y[j];
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (total <= 0.0) return T;
+  const Eigen::Vector3d mean_x = sum_x / total, mean_y = sum_y / total;
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();  // sum w (y - mean_y)(x - mean_x)^T
+  for (std::size_t j = 0; j < y.size(); ++j) {
+    if (terms[j].weight <= 0.0) continue;
+    cross += (y[j] - mean_y) * (terms[j].weighted_target - terms[j].weight * mean_x).transpose();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  T.linear() = svd.matrixV() * d * svd.matrixU().transpose();
+  T.translation() = mean_x - T.linear() * mean_y;
+  return T;
+}
+
+Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle < 1e-12) return Eigen::Matrix3d::Identity() + Skew(w);
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+}  // namespace
+
+double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
+  const Eigen::Matrix3d delta = estimate.linear().transpose() * truth.linear();
+  const double c = std::clamp((delta.trace() - 1.0) / 2.0, -1.0, 1.0);
+  return std::acos(c) * 180.0 / M_PI;
+}
+
+double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
+  return (estimate.translation() - truth.translation()).norm();
+}
+
+RegistrationResult Register(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
+                            const RegistrationOptions& options) {
+  if (!initial.matrix().allFinite()) throw RegistrationError("registration: the initial guess is not finite");
+  RegistrationResult result;
+  PointCloud target = CleanCloud(target_in, options.max_variance, &result.target_points);
+  PointCloud source = CleanCloud(source_in, options.max_variance, &result.source_points);
+  if (target.size() < 3 || source.size() < 3) {
+    throw RegistrationError("registration: needs at least 3 usable points in each cloud (target " +
+                            std::to_string(target.size()) + " of " + std::to_string(target_in.size()) + ", source " +
+                            std::to_string(source.size()) + " of " + std::to_string(source_in.size()) + ")");
+  }
+
+  std::deque<TargetLevel> levels(1);  // a deque: growing it never moves a level its tree points into
+  levels[0].cloud = target;
+  levels[0].Build();
+  const KdTree& tree = *levels[0].tree;
+
+  // Median spacing of the target (nearest other point), the scale of "close".
+  std::vector<double> spacing;
+  for (std::size_t i = 0; i < target.size(); i += std::max<std::size_t>(1, target.size() / 2000)) {
+    std::uint32_t index[2];
+    double d2[2];
+    if (tree.knnSearch(target.points[i].data(), 2, index, d2) == 2) spacing.push_back(std::sqrt(d2[1]));
+  }
+  const double point_spacing = std::max(Median(spacing), 1e-6);
+
+  if (options.relative_covariances) {
+    std::vector<double> variances;
+    for (const auto& c : target.covariances) variances.push_back(c.trace() / 3.0);
+    const double scale = point_spacing * point_spacing / std::max(Median(variances), 1e-300);
+    for (auto& c : target.covariances) c *= scale;
+    for (auto& c : source.covariances) c *= scale;
+  }
+  bool isotropic = true;
+  for (const auto& c : target.covariances) isotropic = isotropic && IsIsotropic(c);
+  for (const auto& c : source.covariances) isotropic = isotropic && IsIsotropic(c);
+  std::vector<double> target_variances;
+  for (const auto& c : target.covariances) target_variances.push_back(c.trace() / 3.0);
+  const double typical_target_variance = Median(target_variances);
+
+  levels[0].cloud.covariances = target.covariances;  // scaled above
+  for (double voxel = 4.0 * point_spacing; voxel <= 1.0; voxel *= 2.0) {
+    PointCloud coarse = VoxelDownsample(target, voxel);
+    if (coarse.size() < 50) break;
+    TargetLevel& level = levels.emplace_back();  // built in place: its tree refers to its points
+    level.voxel = voxel;
+    level.cloud = std::move(coarse);
+    level.Build();
+  }
+
+  Eigen::Isometry3d T = initial;
+  double anneal = options.anneal_start;
+  if (anneal < 0.0) {
+    std::vector<double> distances;
+    for (std::size_t j = 0; j < source.size(); j += std::max<std::size_t>(1, source.size() / 2000)) {
+      const Eigen::Vector3d y = T * source.points[j];
+      std::uint32_t index;
+      double d2;
+      tree.knnSearch(y.data(), 1, &index, &d2);
+      distances.push_back(std::sqrt(d2));
+    }
+    // Points on a plane find near neighbours whatever the misalignment along it, so the spread
+    // also starts at a fraction of the target's size.
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& p : target.points) centroid += p;
+    centroid /= static_cast<double>(target.size());
+    double spread2 = 0.0;
+    for (const auto& p : target.points) spread2 += (p - centroid).squaredNorm();
+    const double rms_radius = std::sqrt(spread2 / static_cast<double>(target.size()));
+    anneal = std::clamp(std::max(Median(distances), 0.3 * rms_radius), point_spacing, 1.0);
+  }
+
+  const bool icp = options.method == RegistrationMethod::kIcp;
+  const int k = icp ? 1 : std::max(1, options.neighbours);
+  const double gate2 = options.truncation_sigmas * options.truncation_sigmas;
+  // The source at each level's resolution too: while the spread is wide, fewer source points
+  // carry the same information, and the early iterations cost a fraction of the late ones.
+  std::vector<PointCloud> source_levels(levels.size());
+  source_levels[0] = source;
+  if (options.max_source_points > 0 && source.size() > static_cast<std::size_t>(options.max_source_points)) {
+    // Every k-th point: the target keeps its full density, which is what the accuracy rests on.
+    const std::size_t stride = (source.size() + options.max_source_points - 1) / options.max_source_points;
+    PointCloud thinned;
+    for (std::size_t j = 0; j < source.size(); j += stride) thinned.Add(source.points[j], source.covariances[j]);
+    source_levels[0] = std::move(thinned);
+  }
+  for (std::size_t l = 1; l < levels.size(); ++l) source_levels[l] = VoxelDownsample(source, levels[l].voxel);
+  std::vector<SourceTerms> terms(source.size());
+
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    const Eigen::Matrix3d R = T.linear();
+    const Eigen::Vector3d t = T.translation();
+    const double spread2 = 2.0 * anneal * anneal;
+    // ICP rejects pairs farther than 3 annealing spreads (at least 3 point spacings).
+    const double icp_reject2 = std::pow(3.0 * std::max(anneal, point_spacing), 2);
+    // The coarsest target whose voxels are no wider than the spread (ICP: always the full cloud).
+    std::size_t level_index = 0;
+    while (!icp && level_index + 1 < levels.size() && levels[level_index + 1].voxel <= anneal) ++level_index;
+    const TargetLevel& level = levels[level_index];
+    const PointCloud& moving = icp ? source : source_levels[level_index];
+    terms.resize(moving.size());
+
+    // E-step, in parallel over source points; each writes only its own terms (deterministic).
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(moving.size()); ++jj) {
+      const std::size_t j = static_cast<std::size_t>(jj);
+      SourceTerms& term = terms[j];
+      term = SourceTerms{};
+      const Eigen::Vector3d y = R * moving.points[j] + t;
+      std::uint32_t index[64];
+      double d2[64];
+      const std::size_t found = level.tree->knnSearch(y.data(), static_cast<std::size_t>(std::min(k, 64)), index, d2);
+      if (icp) {
+        if (found == 0 || d2[0] > icp_reject2) continue;
+        term.weight = 1.0;
+        term.weighted_target = level.cloud.points[index[0]];
+        term.cost = d2[0];
+        term.pairs = 1;
+        continue;
+      }
+      const Eigen::Matrix3d source_cov = R * moving.covariances[j] * R.transpose();
+      // Outlier term: the density of a pair at the truncation distance with typical covariances.
+      const Eigen::Matrix3d typical = source_cov + (typical_target_variance + spread2) * Eigen::Matrix3d::Identity();
+      const double outlier = options.outlier_weight * std::exp(-0.5 * gate2) / std::sqrt(typical.determinant());
+      double weights[64];
+      Eigen::Matrix3d informations[64];
+      double total = 0.0;
+      for (std::size_t n = 0; n < found; ++n) {
+        const Eigen::Vector3d d = level.cloud.points[index[n]] - y;
+        double m = 0.0, determinant = 0.0;
+        if (isotropic) {  // C = c I: no 3x3 inverse per pair
+          const double c = level.cloud.covariances[index[n]](0, 0) + source_cov(0, 0) + spread2;
+          informations[n] = Eigen::Matrix3d::Identity() / c;
+          m = d.squaredNorm() / c;
+          determinant = c * c * c;
+        } else {
+          const Eigen::Matrix3d C = level.cloud.covariances[index[n]] + source_cov + spread2 * Eigen::Matrix3d::Identity();
+          informations[n] = C.inverse();
+          m = d.dot(informations[n] * d);
+          determinant = C.determinant();
+        }
+        weights[n] = m > gate2 ? 0.0 : std::exp(-0.5 * m) / std::sqrt(determinant);
+        total += weights[n];
+      }
+      if (total <= 0.0) continue;
+      for (std::size_t n = 0; n < found; ++n) {
+        if (weights[n] <= 0.0) continue;
+        const double w = weights[n] / (total + outlier);  // posterior of the pair
+        const Eigen::Vector3d& x = level.cloud.points[index[n]];
+        const Eigen::Vector3d r = x - y;
+        term.cost += w * r.dot(informations[n] * r);
+        ++term.pairs;
+        if (isotropic) {
+          const double omega = w * informations[n](0, 0);
+          term.weight += omega;
+          term.weighted_target += omega * x;
+        } else {
+          // r(delta) = x - (exp(dtheta) R y_src + t + dt): J = [ [R y_src]x , -I ].
+          Eigen::Matrix<double, 3, 6> J;
+          J.leftCols<3>() = Skew(R * moving.points[j]);
+          J.rightCols<3>() = -Eigen::Matrix3d::Identity();
+          term.H += w * J.transpose() * informations[n] * J;
+          term.g += w * J.transpose() * informations[n] * r;
+          term.weight += w;
+        }
+      }
+    }
+
+    // M-step.
+    double cost = 0.0;
+    int matched = 0;  // source points with at least one pair
+    int pairs = 0;
+    for (const auto& term : terms) {
+      cost += term.cost;
+      matched += term.weight > 0.0 ? 1 : 0;
+      pairs += term.pairs;
+    }
+    Eigen::Isometry3d next = T;
+    if (icp || isotropic) {
+      next = WeightedKabsch(terms, moving.points);
+    } else {
+      Matrix6 H = Matrix6::Zero();
+      Vector6 g = Vector6::Zero();
+      for (const auto& term : terms) {
+        H += term.H;
+        g += term.g;
+      }
+      if (pairs > 0) {
+        const Vector6 delta = -(H + 1e-9 * Matrix6::Identity()).ldlt().solve(g);
+        if (delta.allFinite()) {
+          next.linear() = ExpSO3(delta.head<3>()) * T.linear();
+          next.translation() = T.translation() + delta.tail<3>();
+        }
+      }
+    }
+    if (pairs == 0 || !next.matrix().allFinite()) {
+      result.iterations = iteration + 1;
+      break;  // nothing matched: keep the last transform rather than invent one
+    }
+    const double step = std::acos(std::clamp(((next.linear().transpose() * T.linear()).trace() - 1.0) / 2.0, -1.0, 1.0)) +
+                        (next.translation() - T.translation()).norm();
+    T = next;
+    result.iterations = iteration + 1;
+    result.final_cost = matched > 0 ? cost / matched : 0.0;
+    result.pairs = pairs;
+    const bool annealed = anneal == 0.0;
+    if (step < options.tolerance && annealed) {
+      result.converged = true;
+      break;
+    }
+    anneal *= options.anneal_factor;
+    if (anneal < 0.5 * point_spacing) anneal = 0.0;  // below the point spacing the points' own covariances rule
+  }
+  // Re-orthonormalize against accumulated rounding.
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.linear(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  T.linear() = svd.matrixU() * svd.matrixV().transpose();
+  result.transform = T;
+  return result;
+}
+
+}  // namespace trimbot::perception

@@ -1,0 +1,107 @@
+// Point-cloud registration (DUGMA and the ICP baseline) on synthetic garden-like clouds with known
+// transforms and noise; bad input; the DUGMA data set's file format.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "registration_command.h"
+#include "synthetic_clouds.h"
+#include "test_support.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/perception/registration.h"
+
+namespace trimbot::perception {
+namespace {
+
+TEST(Dugma, RecoversALargeMotionFromIdentity) {
+  const PointCloud x = GardenScene(4000, 1, false);
+  const Eigen::Isometry3d truth = Transform(20.0, 5.0, {0.4, -0.3, 0.1});
+  const PointCloud y = ObservedFrom(x, truth, 2);
+  const RegistrationResult r = Register(x, y, Eigen::Isometry3d::Identity());
+  EXPECT_LT(RotationErrorDegrees(r.transform, truth), 0.5);
+  EXPECT_LT(TranslationError(r.transform, truth), 0.01);
+  EXPECT_GT(r.pairs, 1000);
+  EXPECT_TRUE(std::isfinite(r.final_cost));
+}
+
+TEST(Dugma, UsesAnisotropicCovariances) {
+  const PointCloud x = GardenScene(4000, 3, true);
+  const Eigen::Isometry3d truth = Transform(-12.0, 3.0, {-0.2, 0.3, 0.05});
+  const PointCloud y = ObservedFrom(x, truth, 4);
+  const RegistrationResult r = Register(x, y, Eigen::Isometry3d::Identity());
+  EXPECT_LT(RotationErrorDegrees(r.transform, truth), 0.5);
+  EXPECT_LT(TranslationError(r.transform, truth), 0.015);
+}
+
+TEST(Icp, BaselineThroughTheSameApiConvergesFromANearGuess) {
+  const PointCloud x = GardenScene(4000, 5, false);
+  const Eigen::Isometry3d truth = Transform(4.0, 1.0, {0.05, 0.05, 0.0});
+  const PointCloud y = ObservedFrom(x, truth, 6);
+  RegistrationOptions icp;
+  icp.method = RegistrationMethod::kIcp;
+  const RegistrationResult r = Register(x, y, Eigen::Isometry3d::Identity(), icp);
+  EXPECT_LT(RotationErrorDegrees(r.transform, truth), 1.0);
+  EXPECT_LT(TranslationError(r.transform, truth), 0.02);
+}
+
+TEST(Registration, BadPointsAreDroppedAndCountedNeverNaN) {
+  PointCloud x = GardenScene(2000, 7, false);
+  const Eigen::Isometry3d truth = Transform(8.0, 0.0, {0.1, 0.0, 0.0});
+  PointCloud y = ObservedFrom(x, truth, 8);
+  x.points[3] = Eigen::Vector3d(NAN, 0, 0);
+  x.covariances[4](1, 1) = NAN;
+  x.covariances[5] = Eigen::Matrix3d::Zero();               // singular
+  x.covariances[6] = Eigen::Vector3d(1, -1, 1).asDiagonal();  // not positive definite
+  y.covariances[0] = 1e6 * Eigen::Matrix3d::Identity();     // above max_variance: unusable
+  const RegistrationResult r = Register(x, y, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(r.target_points.non_finite, 2);
+  EXPECT_EQ(r.target_points.unusable_covariance, 2);
+  EXPECT_EQ(r.source_points.unusable_covariance, 1);
+  EXPECT_TRUE(r.transform.matrix().allFinite());
+  EXPECT_LT(RotationErrorDegrees(r.transform, truth), 0.5);
+}
+
+TEST(Registration, EmptyOrMismatchedInputIsAClearError) {
+  const PointCloud x = GardenScene(500, 9, false);
+  PointCloud empty;
+  EXPECT_THROW(Register(x, empty, Eigen::Isometry3d::Identity()), RegistrationError);
+  PointCloud all_nan;
+  all_nan.Add(Eigen::Vector3d::Constant(NAN), Eigen::Matrix3d::Identity());
+  all_nan.Add(Eigen::Vector3d::Constant(NAN), Eigen::Matrix3d::Identity());
+  all_nan.Add(Eigen::Vector3d::Constant(NAN), Eigen::Matrix3d::Identity());
+  try {
+    Register(all_nan, x, Eigen::Isometry3d::Identity());
+    FAIL() << "expected a RegistrationError";
+  } catch (const RegistrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("target 0 of 3"), std::string::npos) << e.what();
+  }
+  PointCloud mismatched = x;
+  mismatched.covariances.pop_back();
+  EXPECT_THROW(Register(x, mismatched, Eigen::Isometry3d::Identity()), std::invalid_argument);
+  Eigen::Isometry3d bad_guess = Eigen::Isometry3d::Identity();
+  bad_guess.translation().x() = NAN;
+  EXPECT_THROW(Register(x, x, bad_guess), RegistrationError);
+}
+
+TEST(RegistrationPairFile, ReadsTheDataSetFormatAndNamesBadLines) {
+  const std::string good = testing::WriteTempFile(
+      "pair_good.txt",
+      "# comment\nR 1 0 0 0 1 0 0 0 1\nt 0.5 0 0\nX 2  # x y z c\n0 0 0 1 0 0 1 0 1\n1 0 0 nan 0 0 1 0 1\n"
+      "Y 1\n0 1 0 2 0 0 2 0 2\n");
+  const scenarios::RegistrationPair pair = scenarios::LoadRegistrationPair(good);
+  EXPECT_EQ(pair.x.size(), 2u);
+  EXPECT_EQ(pair.y.size(), 1u);
+  EXPECT_NEAR(pair.truth.translation().x(), 0.5, 1e-12);
+  EXPECT_TRUE(std::isnan(pair.x.covariances[1](0, 0)));
+  const std::string bad = testing::WriteTempFile("pair_bad.txt", "R 1 0 0 0 1 0 0 0 1\nt 0 0 0\nX 1\n0 0 zero 1 0 0 1 0 1\n");
+  try {
+    scenarios::LoadRegistrationPair(bad);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pair_bad.txt: line 4"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace trimbot::perception
