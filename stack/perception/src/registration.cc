@@ -279,6 +279,8 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
         total += weights[n];
       }
       if (total <= 0.0) continue;
+      Eigen::Matrix3d information_sum = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d weighted_residual = Eigen::Vector3d::Zero();
       for (std::size_t n = 0; n < found; ++n) {
         if (weights[n] <= 0.0) continue;
         const double w = weights[n] / (total + outlier);  // posterior of the pair
@@ -291,14 +293,19 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
           term.weight += omega;
           term.weighted_target += omega * x;
         } else {
-          // r(delta) = x - (exp(dtheta) R y_src + t + dt): J = [ [R y_src]x , -I ].
-          Eigen::Matrix<double, 3, 6> J;
-          J.leftCols<3>() = Skew(R * moving.points[j]);
-          J.rightCols<3>() = -Eigen::Matrix3d::Identity();
-          term.H += w * J.transpose() * informations[n] * J;
-          term.g += w * J.transpose() * informations[n] * r;
+          information_sum += w * informations[n];
+          weighted_residual += w * informations[n] * r;
           term.weight += w;
         }
+      }
+      if (!isotropic && term.weight > 0.0) {
+        // r(delta) = x - (exp(dtheta) R y_src + t + dt): J = [ [R y_src]x , -I ], the same for all
+        // of this point's pairs, so their information sums before the 6x6 products.
+        Eigen::Matrix<double, 3, 6> J;
+        J.leftCols<3>() = Skew(R * moving.points[j]);
+        J.rightCols<3>() = -Eigen::Matrix3d::Identity();
+        term.H = J.transpose() * information_sum * J;
+        term.g = J.transpose() * weighted_residual;
       }
     }
 
