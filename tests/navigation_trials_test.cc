@@ -83,6 +83,8 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
       {"collisions: \\{max: 0\\}", "colisions: {max: 0}", "colisions"},
       {"success_rate: \\{min: 1.0\\}", "success_rate: {min: 1.0, max: 2.0}", "exactly one"},
       {"speed: 0.25", "speed: 2.5", "speed"},
+      {"speed: 0.25", "speed: 0.25\nspeed: 0.3", "appears twice"},
+      {"start: \\{x: 0.0", "start: {x: .nan", "finite"},
   };
   for (const auto& c : cases) {
     const std::string path = SmokeVariant("bad_scenario.yaml", c.replace, c.with);

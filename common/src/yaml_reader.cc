@@ -118,8 +118,14 @@ std::vector<YamlMap> YamlMap::MapList(const std::string& key) const {
 }
 
 void YamlMap::RejectUnknownKeys() const {
+  std::set<std::string> seen;
   for (const auto& entry : node_) {
+    if (!entry.first.IsScalar()) throw InputError(file_, LineOf(entry.first) + "keys must be plain names");
     const std::string key = entry.first.as<std::string>();
+    // yaml-cpp keeps one of two equal keys silently; a repeated key is a mistake in the file.
+    if (!seen.insert(key).second) {
+      throw InputError(file_, LineOf(entry.first) + "key '" + (path_.empty() ? key : path_ + "." + key) + "' appears twice");
+    }
     if (read_keys_.count(key) == 0) {
       const std::string full_key = path_.empty() ? key : path_ + "." + key;
       throw InputError(file_, LineOf(entry.first) + "unknown key '" + full_key + "'");

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
+#include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -167,7 +169,7 @@ struct RunningTrial {
 [[noreturn]] void RunTrialProcess(const TrialSetup& setup) {
   int code = 0;
   try {
-    stack::SeedPlanner(static_cast<std::uint32_t>(setup.seed & 0xffffffffu));
+    stack::SeedPlanner(setup.seed);
     RunTrial(setup, [&](double t) {
       std::ofstream(setup.dir + "/progress") << t << "\n";
     });
@@ -233,12 +235,24 @@ int RunBatch(const BatchOptions& options) {
   const int planned = static_cast<int>(queue.size());
   std::reverse(queue.begin(), queue.end());  // pop from the back in index order
 
+  // Children are reaped here: an inherited SIGCHLD=SIG_IGN would make the kernel reap them first.
+  signal(SIGCHLD, SIG_DFL);
   const bool interactive = isatty(STDOUT_FILENO) != 0;
   std::cout << "[run] " << scenario.name << ": " << planned << " trials (shard " << info.shard_index << "/"
             << info.shard_count << ", seeds " << info.seed << "+i), " << options.jobs << " at a time -> " << out
             << std::endl;
   const auto batch_start = Clock::now();
   std::vector<RunningTrial> running;
+  // If the batch stops on an exception, no trial process is left running into the output folder.
+  struct KillOnExit {
+    std::vector<RunningTrial>& trials;
+    ~KillOnExit() {
+      for (const auto& trial : trials) {
+        kill(trial.pid, SIGKILL);
+        waitpid(trial.pid, nullptr, 0);
+      }
+    }
+  } kill_on_exit{running};
   std::vector<TrialResult> results;
   auto finish = [&](const TrialResult& result) {
     results.push_back(result);
@@ -269,7 +283,11 @@ int RunBatch(const BatchOptions& options) {
       const pid_t done = waitpid(it->pid, &status, WNOHANG);
       const double wall = std::chrono::duration<double>(Clock::now() - it->started).count();
       std::optional<TrialResult> result;
-      if (done == it->pid) {
+      if (done < 0 && errno != EINTR) {
+        // The child is gone without us reaping it: take whatever it left, never kill a reused pid.
+        result = ReadTrialResult(it->dir);
+        if (!result) result = Unfinished(it->index, it->seed, "crashed", std::string("lost: ") + std::strerror(errno));
+      } else if (done == it->pid) {
         result = ReadTrialResult(it->dir);
         if (WIFSIGNALED(status)) {
           result = Unfinished(it->index, it->seed, "crashed", "killed by signal " + std::to_string(WTERMSIG(status)) +
@@ -319,16 +337,28 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   if (shard_dirs.empty()) throw InputError(out_dir, "merge needs at least one shard folder");
   std::optional<BatchInfo> batch;
   std::map<int, TrialResult> results;
+  fs::remove_all(out_dir + "/trials");  // no trial of an earlier merge may pass for one of this batch
   fs::create_directories(out_dir + "/trials");
+  std::string scenario_text;
+  auto read_text = [](const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, "not found");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
   for (const auto& dir : shard_dirs) {
     const BatchInfo info = ReadBatchInfo(dir);
+    const std::string text = read_text(dir + "/scenario.yaml");
     if (!batch) {
       batch = info;
+      scenario_text = text;
       fs::copy(dir + "/scenario.yaml", out_dir + "/scenario.yaml", fs::copy_options::overwrite_existing);
       fs::create_directories(out_dir + "/map");
       fs::copy(dir + "/map", out_dir + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
-    } else if (info.seed != batch->seed || info.trials != batch->trials || info.shard_count != batch->shard_count) {
-      throw InputError(dir + "/batch.json", "belongs to another batch (seed, trials or shard count differ from " +
+    } else if (info.seed != batch->seed || info.trials != batch->trials || info.shard_count != batch->shard_count ||
+               text != scenario_text) {
+      throw InputError(dir + "/batch.json", "belongs to another batch (scenario, seed, trials or shard count differ from " +
                                                  shard_dirs.front() + ")");
     }
     for (int i = info.shard_index; i < info.trials; i += info.shard_count) {
@@ -343,13 +373,15 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   merged.shard_index = 0;
   merged.shard_count = 1;
   WriteFileAtomically(out_dir + "/batch.json", ToJson(merged).dump(2));
-  std::vector<TrialResult> all;
-  for (int i = 0; i < merged.trials; ++i) {
-    all.push_back(results.count(i) ? results[i]
-                                   : Unfinished(i, merged.seed + i, "not run", "no result in the merged shards"));
+  // Trials missing from the shards count as failed through trials_planned, as in a single run.
+  std::vector<TrialResult> found;
+  for (const auto& [index, result] : results) found.push_back(result);
+  if (static_cast<int>(found.size()) < merged.trials) {
+    std::cerr << "merge: " << merged.trials - static_cast<int>(found.size()) << " of " << merged.trials
+              << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
-  return WriteReports(out_dir, scenario, merged, all, merged.trials);
+  return WriteReports(out_dir, scenario, merged, found, merged.trials);
 }
 
 }  // namespace trimbot::scenarios

@@ -21,7 +21,8 @@ sim::Fault ReadFault(const YamlMap& item) {
     fault.duration = item.Double("duration");
     fault.slip_left = item.Double("left", 0.0);
     fault.slip_right = item.Double("right", 0.0);
-    if (fault.slip_left <= -1.0 || fault.slip_right <= -1.0) item.Fail("left", "slip must be greater than -1");
+    if (fault.slip_left <= -1.0) item.Fail("left", "slip must be greater than -1");
+    if (fault.slip_right <= -1.0) item.Fail("right", "slip must be greater than -1");
   } else if (type == "imu_bias_jump") {
     fault.kind = sim::Fault::Kind::kImuBiasJump;
     fault.start = item.Double("time");
@@ -94,13 +95,17 @@ Scenario Scenario::Load(const std::string& path) {
     map.RejectUnknownKeys();
     if (!(s.map_resolution > 0.0)) map.Fail("resolution", "must be positive");
   }
+  const auto finite = [](const YamlMap& map, const std::string& key, double value) {
+    if (!std::isfinite(value)) map.Fail(key, "must be a finite number");
+    return value;
+  };
   const YamlMap start = root.Map("start");
-  s.start.x = start.Double("x");
-  s.start.y = start.Double("y");
-  s.start.yaw = start.Double("yaw_deg", 0.0) * M_PI / 180.0;
+  s.start.x = finite(start, "x", start.Double("x"));
+  s.start.y = finite(start, "y", start.Double("y"));
+  s.start.yaw = finite(start, "yaw_deg", start.Double("yaw_deg", 0.0)) * M_PI / 180.0;
   start.RejectUnknownKeys();
   for (const YamlMap& goal : root.MapList("goals")) {
-    s.goals.emplace_back(goal.Double("x"), goal.Double("y"));
+    s.goals.emplace_back(finite(goal, "x", goal.Double("x")), finite(goal, "y", goal.Double("y")));
     goal.RejectUnknownKeys();
   }
   if (s.goals.empty()) root.Fail("goals", "needs at least one goal");
@@ -144,6 +149,7 @@ Scenario Scenario::Load(const std::string& path) {
   if (root.Has("criteria")) {
     const YamlMap criteria = root.Map("criteria");
     for (const auto& entry : criteria.node()) {
+      if (!entry.first.IsScalar()) criteria.Fail("criteria", "metric names must be plain names");
       const std::string metric = entry.first.as<std::string>();
       if (!IsKnownMetric(metric)) criteria.Fail(metric, "unknown metric");
       const YamlMap bound = criteria.Map(metric);

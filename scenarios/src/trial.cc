@@ -1,5 +1,6 @@
 #include "trial.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -51,19 +52,22 @@ void AddError(EstimateErrors& errors, const PlanarPose& truth, double x, double 
 // Ground truth of the last few seconds, to judge late pose fixes at their own stamps.
 class TruthHistory {
  public:
+  TruthHistory(double seconds, double timestep) : seconds_(seconds), timestep_(timestep) {}
   void Add(const PlanarPose& pose) {
     poses_.push_back(pose);
-    while (poses_.size() > 2 && poses_.front().t < pose.t - 5.0) poses_.pop_front();
+    while (poses_.size() > 2 && poses_.front().t < pose.t - seconds_) poses_.pop_front();
   }
+  // The pose at time t (to within a physics step), or nullptr if it is no longer kept.
   const PlanarPose* At(double t) const {
     const PlanarPose* best = nullptr;
     for (const auto& p : poses_) {
       if (best == nullptr || std::abs(p.t - t) < std::abs(best->t - t)) best = &p;
     }
-    return best;
+    return best != nullptr && std::abs(best->t - t) <= timestep_ ? best : nullptr;
   }
 
  private:
+  double seconds_, timestep_;
   std::deque<PlanarPose> poses_;
 };
 
@@ -110,11 +114,11 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   EstimateErrors ekf_errors{"ekf", {}, {}}, odometry_errors{"wheel_odometry", {}, {}}, fix_errors{"pose_fixes", {}, {}};
   std::string truth_tum, ekf_tum, odometry_tum, fixes_tum;
   std::string events_csv = "t,event,goal,detail\n";
-  TruthHistory truth_history;
+  TruthHistory truth_history(scenario.pose_fixes.latency_max + 1.0, simulator.timestep());
   PlanarPose previous_truth = Planar(0.0, simulator.ground_truth().T_map_base);
   bool in_contact = false;
-  int goals_reached = 0;
   int plans = 0;
+  std::vector<bool> goal_planned(scenario.goals.size(), false);
   long step = 0;
   const long control_steps = std::lround(kControlPeriod / simulator.timestep());
   const long evaluation_steps = std::lround(kEvaluationPeriod / simulator.timestep());
@@ -184,14 +188,16 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
              << event.goal << ',' << event.detail << '\n';
         events_csv += line.str();
         using Type = stack::NavigationEvent::Type;
-        if (event.type == Type::kPlanned) ++plans;
+        if (event.type == Type::kPlanned) {
+          ++plans;
+          goal_planned[event.goal] = true;
+        }
         if (event.type == Type::kRecovered) ++result.recoveries;
         if (event.type == Type::kGoalReached) {
           GoalResult& goal = result.goals[event.goal];
           goal.arrival_time = t;
           goal.final_error_m = std::hypot(truth.x - goal.x, truth.y - goal.y);
           goal.reached = goal.final_error_m <= scenario.goal_tolerance;
-          ++goals_reached;
         }
       }
     }
@@ -210,9 +216,9 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
       next_progress += 1.0;
     }
   }
-  // One plan per goal attempted is expected; the others were replans.
-  const int goals_attempted = goals_reached + (result.status == "completed" ? 0 : 1);
-  result.replans = std::max(0, plans - goals_attempted);
+  // One plan per goal that got a plan is expected; the others were replans.
+  const int goals_planned = static_cast<int>(std::count(goal_planned.begin(), goal_planned.end(), true));
+  result.replans = plans - goals_planned;
 
   result.simulated_seconds = simulator.time();
   const auto& counters = ekf.counters();

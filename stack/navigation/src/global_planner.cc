@@ -9,6 +9,8 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include "trimbot/common/random.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -77,7 +79,11 @@ double Footprint::Clearance(const OccupancyGrid& map, double x, double y, double
   return clearance;
 }
 
-void SeedPlanner(std::uint32_t seed) { ompl::RNG::setSeed(seed == 0 ? 1 : seed); }
+void SeedPlanner(std::uint64_t seed) {
+  // OMPL takes 32 bits and refuses 0: mix all 64 bits so nearby or 2^32-apart seeds differ.
+  const auto mixed = static_cast<std::uint32_t>(SplitMix64(seed) >> 32);
+  ompl::RNG::setSeed(mixed == 0 ? 0x9e3779b9u : mixed);
+}
 
 GlobalPlanner::GlobalPlanner(const OccupancyGrid& map, const PlannerParameters& parameters)
     : map_(map), parameters_(parameters) {

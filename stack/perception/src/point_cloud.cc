@@ -5,6 +5,9 @@
 
 namespace trimbot::perception {
 
+// Beyond this (m) a coordinate is garbage, not a garden; it would also overflow voxel indices.
+constexpr double kMaxCoordinate = 1e6;
+
 PointCloud CleanCloud(const PointCloud& cloud, double max_variance, CleanReport* report) {
   if (cloud.points.size() != cloud.covariances.size()) {
     throw std::invalid_argument("point cloud has " + std::to_string(cloud.points.size()) + " points but " +
@@ -17,7 +20,7 @@ PointCloud CleanCloud(const PointCloud& cloud, double max_variance, CleanReport*
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d& p = cloud.points[i];
     const Eigen::Matrix3d& c = cloud.covariances[i];
-    if (!p.allFinite() || !c.allFinite()) {
+    if (!p.allFinite() || !c.allFinite() || p.cwiseAbs().maxCoeff() > kMaxCoordinate) {
       ++counts.non_finite;
       continue;
     }

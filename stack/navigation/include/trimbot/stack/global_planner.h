@@ -44,7 +44,7 @@ struct PlanResult {
 
 // Seeds OMPL's random numbers for this process. Call once, before the first plan (OMPL seeds each
 // planner's generator from this seed in turn, so the sequence of plans is reproducible).
-void SeedPlanner(std::uint32_t seed);
+void SeedPlanner(std::uint64_t seed);
 
 class GlobalPlanner {
  public:

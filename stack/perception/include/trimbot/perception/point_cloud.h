@@ -20,7 +20,7 @@ struct PointCloud {
 
 // Points dropped by CleanCloud, by reason.
 struct CleanReport {
-  int non_finite = 0;        // NaN or infinite coordinates or covariance
+  int non_finite = 0;        // NaN, infinite or absurd (> 1e6 m) coordinates, or NaN covariance
   int unusable_covariance = 0;  // not symmetric positive definite, or above max_variance
   int kept = 0;
 };
