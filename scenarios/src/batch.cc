@@ -49,6 +49,14 @@ json ToJson(const BatchInfo& info) {
           {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)}};
 }
 
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "not found");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 BatchInfo ReadBatchInfo(const std::string& dir) {
   const std::string path = dir + "/batch.json";
   std::ifstream in(path);
@@ -217,12 +225,7 @@ int RunBatch(const BatchOptions& options) {
 
   fs::create_directories(out);
   WriteFileAtomically(out + "/batch.json", ToJson(info).dump(2));
-  {
-    std::ifstream in(options.scenario_path);
-    std::stringstream text;
-    text << in.rdbuf();
-    WriteFileAtomically(out + "/scenario.yaml", text.str());
-  }
+  WriteFileAtomically(out + "/scenario.yaml", ReadText(options.scenario_path));
   // The robot's prior map, from the garden's object map (as the real robot's sketch map).
   const garden::Garden garden = garden::Garden::Load(garden::Garden::Resolve(scenario.garden, options.paths.gardens_dir()));
   garden::WriteOccupancyMap(garden::MakeOccupancyMap(garden, scenario.map_resolution, scenario.map_clearance_height),
@@ -340,20 +343,13 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   fs::remove_all(out_dir + "/trials");  // no trial of an earlier merge may pass for one of this batch
   fs::create_directories(out_dir + "/trials");
   std::string scenario_text;
-  auto read_text = [](const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw InputError(path, "not found");
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  };
   for (const auto& dir : shard_dirs) {
     const BatchInfo info = ReadBatchInfo(dir);
-    const std::string text = read_text(dir + "/scenario.yaml");
+    const std::string text = ReadText(dir + "/scenario.yaml");
     if (!batch) {
       batch = info;
       scenario_text = text;
-      fs::copy(dir + "/scenario.yaml", out_dir + "/scenario.yaml", fs::copy_options::overwrite_existing);
+      WriteFileAtomically(out_dir + "/scenario.yaml", text);
       fs::create_directories(out_dir + "/map");
       fs::copy(dir + "/map", out_dir + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
     } else if (info.seed != batch->seed || info.trials != batch->trials || info.shard_count != batch->shard_count ||

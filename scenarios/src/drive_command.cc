@@ -119,10 +119,7 @@ int RunDrive(const DriveOptions& options) {
                       static_cast<long long>(t.right));
         ticks_csv += line;
         odometry.Update(t);
-        Eigen::Isometry3d T_odom_base = Eigen::Isometry3d::Identity();
-        T_odom_base.translation() << odometry.pose().x, odometry.pose().y, 0.0;
-        T_odom_base.linear() = Eigen::AngleAxisd(odometry.pose().yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-        odometry_tum += TumLine(t.stamp, T_map_odom * T_odom_base);
+        odometry_tum += TumLine(t.stamp, T_map_odom * stack::ToIsometry(odometry.pose()));
       }
       const sim::GroundTruth truth = simulator.ground_truth();
       base_tum += TumLine(truth.stamp, truth.T_map_base);

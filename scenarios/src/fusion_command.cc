@@ -10,6 +10,7 @@
 
 #include "drive_plan.h"
 #include "project_paths.h"
+#include "trial_result.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/perception/registration.h"
 #include "trimbot/perception/stereo.h"
@@ -21,18 +22,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Eigen::Isometry3d Planar(const stack::Pose2& pose) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() << pose.x, pose.y, 0.0;
-  T.linear() = Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return T;
-}
-
-double Mean(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
-}
+double Mean(const std::vector<double>& v) { return ErrorStats::From(v).mean; }
 
 struct Options {
   std::string plan;
@@ -81,7 +71,7 @@ int RunFusion(const Options& options, const ProjectPaths& paths) {
     if (const auto ground = perception::FitGroundPlane(cloud)) {
       cloud = perception::DownsampleGround(cloud, *ground, options.ground_keep, 0.05);
     }
-    Keyframe current{std::move(cloud), Planar(odometry.pose()), simulator.ground_truth().T_map_base};
+    Keyframe current{std::move(cloud), stack::ToIsometry(odometry.pose()), simulator.ground_truth().T_map_base};
     if (previous && !current.cloud.empty() && !previous->cloud.empty()) {
       // Relative pose of the current base in the previous base frame.
       const Eigen::Isometry3d truth = previous->truth.inverse() * current.truth;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <sstream>
 
+#include "trial_result.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/registration.h"
 
@@ -17,12 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+double Median(const std::vector<double>& v) { return ErrorStats::From(v).median; }
 
 }  // namespace
 

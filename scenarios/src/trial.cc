@@ -30,15 +30,8 @@ struct PlanarPose {
 };
 
 PlanarPose Planar(double t, const Eigen::Isometry3d& pose) {
-  const Eigen::Vector3d x_axis = pose.linear().col(0);
-  return {t, pose.translation().x(), pose.translation().y(), std::atan2(x_axis.y(), x_axis.x())};
-}
-
-Eigen::Isometry3d Isometry(double x, double y, double yaw) {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() << x, y, 0.0;
-  pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return pose;
+  const stack::Pose2 planar = stack::ToPose2(pose);
+  return {t, planar.x, planar.y, planar.yaw};
 }
 
 double AngleDifference(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
@@ -71,7 +64,7 @@ class TruthHistory {
   std::deque<PlanarPose> poses_;
 };
 
-std::string TumLine(const PlanarPose& p) { return scenarios::TumLine(p.t, Isometry(p.x, p.y, p.yaw)); }
+std::string TumLine(const PlanarPose& p) { return scenarios::TumLine(p.t, stack::ToIsometry({p.x, p.y, p.yaw})); }
 
 }  // namespace
 
@@ -158,11 +151,12 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
     // Evaluation: path, contacts, estimate errors.
     result.path_length_m += std::hypot(truth.x - previous_truth.x, truth.y - previous_truth.y);
     previous_truth = truth;
-    const bool contact = !simulator.ObstacleContacts().empty();
+    const std::vector<sim::ObstacleContact> contacts = simulator.ObstacleContacts();
+    const bool contact = !contacts.empty();
     if (contact && !in_contact) {
       ++result.collisions;
       events_csv += std::to_string(t) + ",collision," + std::to_string(navigator.current_goal()) + "," +
-                    simulator.ObstacleContacts().front().object_geom + "\n";
+                    contacts.front().object_geom + "\n";
     }
     if (contact) result.contact_seconds += simulator.timestep();
     in_contact = contact;
@@ -170,7 +164,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
     if (step % evaluation_steps == 0) {
       const stack::PoseEstimate estimate = ekf.Estimate();
       const Eigen::Isometry3d odometry_in_map =
-          Isometry(start.x, start.y, start.yaw) * Isometry(odometry.pose().x, odometry.pose().y, odometry.pose().yaw);
+          stack::ToIsometry(start) * stack::ToIsometry(odometry.pose());
       const PlanarPose odometry_pose = Planar(t, odometry_in_map);
       AddError(ekf_errors, truth, estimate.pose.x, estimate.pose.y, estimate.pose.yaw);
       AddError(odometry_errors, truth, odometry_pose.x, odometry_pose.y, odometry_pose.yaw);

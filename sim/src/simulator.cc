@@ -53,6 +53,7 @@ struct Simulator::Impl {
   garden::SlipModel ground_slip[4];
   std::unique_ptr<PoseFixModel> pose_fixes;
   std::vector<bool> fault_applied;
+  int end_effector_body = -1;  // looked up once: ground truth is read every step in closed loop
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
@@ -107,6 +108,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->arm = std::make_unique<ArmController>(parameters_.arm_home_position, ranges);
   mj_forward(m, d);
 
+  impl_->end_effector_body = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
   impl_->pose_fixes = std::make_unique<PoseFixModel>(config.pose_fixes, config.seed);
   impl_->fault_applied.assign(config.faults.size(), false);
   if (config.render_cameras) {
@@ -277,7 +279,7 @@ GroundTruth Simulator::ground_truth() const {
   truth.linear_velocity_base = truth.T_map_base.linear().transpose() * linear_world;
   truth.angular_velocity_base << d->qvel[dof + 3], d->qvel[dof + 4], d->qvel[dof + 5];
   for (size_t i = 0; i < truth.arm_position.size(); ++i) truth.arm_position[i] = d->qpos[world.arm()[i].qpos];
-  const int ee = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
+  const int ee = impl_->end_effector_body;
   if (ee >= 0) truth.T_map_end_effector = PoseFromMujoco(d->xpos + 3 * ee, d->xmat + 9 * ee);
   truth.accelerometer_bias = impl_->imu->accelerometer_bias();
   truth.gyroscope_bias = impl_->imu->gyroscope_bias();

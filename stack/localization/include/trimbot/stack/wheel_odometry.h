@@ -1,5 +1,7 @@
 #pragma once
 // Dead reckoning from wheel encoder counts: the odom -> base_link pose of REP-105.
+#include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 
@@ -11,6 +13,18 @@ namespace trimbot::stack {
 struct Pose2 {
   double x = 0.0, y = 0.0, yaw = 0.0;
 };
+
+// A planar pose as a 3D transform (z = 0), and the planar part of a 3D pose (heading of its x axis).
+inline Eigen::Isometry3d ToIsometry(const Pose2& pose) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() << pose.x, pose.y, 0.0;
+  T.linear() = Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return T;
+}
+inline Pose2 ToPose2(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d x_axis = T.linear().col(0);
+  return {T.translation().x(), T.translation().y(), std::atan2(x_axis.y(), x_axis.x())};
+}
 
 class WheelOdometry {
  public:
