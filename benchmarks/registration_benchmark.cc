@@ -7,7 +7,8 @@
 #include <filesystem>
 #include <map>
 
-#include "registration_command.h"
+#include "cli/registration_command.h"
+#include "eval/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "trimbot/perception/registration.h"
 
@@ -20,6 +21,8 @@
 namespace {
 
 using namespace trimbot::perception;
+using trimbot::scenarios::RotationErrorDegrees;
+using trimbot::scenarios::TranslationError;
 
 struct Pair {
   PointCloud x, y;

@@ -26,9 +26,7 @@ struct Scene {
 const Scene& RenderedScene() {
   static const Scene scene = [] {
     sim::SimulatorConfig config;
-    config.urdf_path = SourcePath("robot/urdf/trimbot.urdf");
-    config.calibration_path = SourcePath("robot/calibration/nominal_camchain.yaml");
-    config.robot_parameters_path = SourcePath("robot/config/robot_parameters.yaml");
+    config.robot = trimbot::robot::RobotFiles::InFolder(SourcePath("robot"));
     config.garden_path = SourcePath("garden_scenes/gardens/test_lawn.yaml");
     config.world_dir = (std::filesystem::temp_directory_path() / "trimbot_stereo_benchmark_world").string();
     config.seed = 1;

@@ -68,7 +68,7 @@ RingCapture* RenderedTargets::capture_ = nullptr;
 
 TEST_F(RenderedTargets, TargetsLandWhereTheCalibrationProjectsThem) {
   const auto& camera = simulator_->rig().camera(0).intrinsics;
-  const cv::Mat& ids = capture_->ground_truth[0].object_id;
+  const cv::Mat& ids = capture_->truth.views[0].object_id;
   int checked = 0;
   double worst = 0.0;
   for (int id = 11; id <= 17; ++id) {
@@ -89,8 +89,8 @@ TEST_F(RenderedTargets, TargetsLandWhereTheCalibrationProjectsThem) {
 }
 
 TEST_F(RenderedTargets, DepthOfTheWallIsThreeMetres) {
-  const cv::Mat& depth = capture_->ground_truth[0].depth;
-  const cv::Mat& ids = capture_->ground_truth[0].object_id;
+  const cv::Mat& depth = capture_->truth.views[0].depth;
+  const cv::Mat& ids = capture_->truth.views[0].object_id;
   int n = 0;
   double worst = 0.0;
   for (int v = 0; v < depth.rows; ++v) {
@@ -117,8 +117,8 @@ TEST_F(RenderedTargets, StereoDisparityIsFocalTimesBaselineOverDepth) {
   const auto& right = simulator_->rig().camera(pair.right).intrinsics;
   double worst = 0.0;
   for (int id = 11; id <= 17; ++id) {
-    const auto centroid_left = Centroid(capture_->ground_truth[pair.left].object_id, id);
-    const auto centroid_right = Centroid(capture_->ground_truth[pair.right].object_id, id);
+    const auto centroid_left = Centroid(capture_->truth.views[pair.left].object_id, id);
+    const auto centroid_right = Centroid(capture_->truth.views[pair.right].object_id, id);
     ASSERT_TRUE(centroid_left && centroid_right) << "target " << id;
     // Undistort both centroids: the nominal pair is parallel, so disparity is along x only.
     const Eigen::Vector2d ray_left = left.Undistort(*centroid_left);
@@ -133,7 +133,7 @@ TEST_F(RenderedTargets, StereoDisparityIsFocalTimesBaselineOverDepth) {
 }
 
 TEST_F(RenderedTargets, LabelsNameTheObjectsAndTheGround) {
-  const cv::Mat& classes = capture_->ground_truth[0].object_class;
+  const cv::Mat& classes = capture_->truth.views[0].object_class;
   std::map<int, int> count;
   for (int v = 0; v < classes.rows; ++v) {
     for (int u = 0; u < classes.cols; ++u) ++count[classes.at<uchar>(v, u)];
@@ -143,8 +143,8 @@ TEST_F(RenderedTargets, LabelsNameTheObjectsAndTheGround) {
   // No pixel carries an unknown class.
   for (const auto& [value, n] : count) EXPECT_LE(value, static_cast<int>(garden::ObjectClass::kRobot));
   // A rear camera sees sky: "nothing" there, and no depth exactly where nothing was hit.
-  const cv::Mat& rear_classes = capture_->ground_truth[5].object_class;
-  const cv::Mat& rear_depth = capture_->ground_truth[5].depth;
+  const cv::Mat& rear_classes = capture_->truth.views[5].object_class;
+  const cv::Mat& rear_depth = capture_->truth.views[5].depth;
   const int sky = cv::countNonZero(rear_classes == 0);
   EXPECT_GT(sky, 50000);
   EXPECT_EQ(cv::countNonZero(rear_depth == 0.0f), sky);
@@ -164,14 +164,15 @@ Recording Record(std::uint64_t seed, const std::string& name) {
   Simulator simulator(config);
   simulator.SetBaseCommand({0.25, 0.1});
   Recording recording;
-  StepOutputs outputs;
+  SensorOutputs outputs;
+  GroundTruth truth_now;
   while (simulator.time() < 0.45) {  // two ring frames at 5 Hz
     outputs.Clear();
-    simulator.Step(&outputs);
+    simulator.Step(&outputs, &truth_now);
     recording.imu.insert(recording.imu.end(), outputs.imu.begin(), outputs.imu.end());
     recording.ticks.insert(recording.ticks.end(), outputs.wheel_ticks.begin(), outputs.wheel_ticks.end());
     if (outputs.ring) {
-      for (const auto& image : outputs.ring->frame.images) recording.images.push_back(image.data);
+      for (const auto& image : outputs.ring->images) recording.images.push_back(image.data);
     }
   }
   return recording;

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "drive_command.h"
+#include "cli/drive_command.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 

@@ -8,10 +8,11 @@
 #include <regex>
 #include <sstream>
 
-#include "batch.h"
-#include "scenario.h"
+#include "runner/batch.h"
+#include "runner/scenario.h"
 #include "test_support.h"
-#include "trial.h"
+#include "runner/prior_knowledge.h"
+#include "runner/trial.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/garden/garden_tools.h"
@@ -49,8 +50,11 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
     EXPECT_EQ(s.name, name);
     EXPECT_EQ(s.goals.size(), 4u);
     EXPECT_EQ(s.trials, 6);
-    EXPECT_NEAR((s.goals.back() - Eigen::Vector2d(s.start.x, s.start.y)).norm(), 0.0, 1e-9) << "a loop";
-    EXPECT_TRUE(s.pose_fixes.enabled);
+    EXPECT_NEAR((s.goals.back() - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9) << "a loop";
+    ASSERT_TRUE(s.stack.has_value());
+    EXPECT_EQ(StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).localization,
+              stack::LocalizationSource::kSimulatedPoseFixes);
+    EXPECT_GT(s.initial_position_sigma, 0.0) << "never the true start";
     EXPECT_FALSE(s.criteria.empty());
   }
 }
@@ -59,11 +63,10 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
 // trials, it has to plan around the bushes).
 TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
   const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/hourglass.yaml"));
-  const garden::Garden g = garden::Garden::Load(garden::Garden::Resolve(s.garden, testing::SourcePath("garden_scenes/gardens")));
-  const garden::OccupancyMap prior = garden::MakeOccupancyMap(g, s.map_resolution, s.map_clearance_height);
+  const garden::OccupancyMap prior = PriorMap(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const double radius = stack::PlannerParameters{}.robot_radius;
-  Eigen::Vector2d from(s.start.x, s.start.y);
+  Eigen::Vector2d from(s.world.start.x, s.world.start.y);
   for (const auto& goal : s.goals) {
     EXPECT_GE(map.DistanceToObstacle(goal), radius) << "goal " << goal.transpose() << " is not reachable";
     double closest = 1e9;
@@ -82,8 +85,11 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
       {"time_limit: 60.0", "time_limit: 60.0\nfaults:\n  - {type: gremlins, start: 1.0}", "gremlins"},
       {"collisions: \\{max: 0\\}", "colisions: {max: 0}", "colisions"},
       {"success_rate: \\{min: 1.0\\}", "success_rate: {min: 1.0, max: 2.0}", "exactly one"},
-      {"speed: 0.25", "speed: 2.5", "speed"},
-      {"speed: 0.25", "speed: 0.25\nspeed: 0.3", "appears twice"},
+      {"goal_tolerance: 0.3", "goal_tolerance: -0.3", "goal_tolerance"},
+      {"goal_tolerance: 0.3", "goal_tolerance: 0.3\ngoal_tolerance: 0.4", "appears twice"},
+      {"time_limit: 60.0", "time_limit: .inf", "finite"},
+      {"position: 0.02", "position: -1", "initial_pose_sigma.position"},
+      {"time_limit: 60.0", "time_limit: 60.0\nsurvey: {growth: 2}", "survey.growth"},
       {"start: \\{x: 0.0", "start: {x: .nan", "finite"},
   };
   for (const auto& c : cases) {
@@ -104,13 +110,11 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
 // run no fix arrives; a slipping left wheel bends the wheel odometry's heading. The summary says
 // what was injected.
 TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
-  stack::SeedPlanner(5);
   const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
   const std::string out = testing::TempDir("trial_faults");
   Scenario clean = Scenario::Load(SmokeVariant("fixes.yaml", "time_limit: 60.0",
-                                               "time_limit: 60.0\nlocalization:\n  pose_fixes: {enabled: true}"));
-  const garden::Garden g = garden::Garden::Load(garden::Garden::Resolve(clean.garden, paths.gardens_dir()));
-  garden::WriteOccupancyMap(garden::MakeOccupancyMap(g, 0.05, 1.0), out + "/map", "map");
+                                               "time_limit: 60.0\nstack: {localization: simulated_pose_fixes}"));
+  WritePriorMap(PriorMap(clean, paths), out + "/map");
 
   Scenario faulty = clean;
   sim::Fault dropout;

@@ -5,13 +5,17 @@
 #include <cmath>
 #include <random>
 
-#include "registration_command.h"
+#include "cli/registration_command.h"
+#include "eval/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/registration.h"
 
 namespace trimbot::perception {
+
+using scenarios::RotationErrorDegrees;
+using scenarios::TranslationError;
 namespace {
 
 TEST(Dugma, RecoversALargeMotionFromIdentity) {

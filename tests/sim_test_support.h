@@ -8,9 +8,7 @@ namespace trimbot::testing {
 inline sim::SimulatorConfig TestConfig(const std::string& garden_file, const std::string& world_name,
                                        bool cameras = false) {
   sim::SimulatorConfig config;
-  config.urdf_path = SourcePath("robot/urdf/trimbot.urdf");
-  config.calibration_path = SourcePath("robot/calibration/nominal_camchain.yaml");
-  config.robot_parameters_path = SourcePath("robot/config/robot_parameters.yaml");
+  config.robot = robot::RobotFiles::InFolder(SourcePath("robot"));
   config.garden_path = garden_file;
   config.world_dir = TempDir(world_name);
   config.seed = 1;

@@ -34,11 +34,12 @@ void DriveAndCompareWithArc(double linear, double angular, double seconds, doubl
   simulator.SetBaseCommand({linear, angular});
   reference.SetCommand({linear, angular});
   PlanarPose expected = {config.start.x, config.start.y, config.start.yaw};
-  StepOutputs outputs;
+  SensorOutputs outputs;
+  GroundTruth truth_now;
   double worst = 0.0, worst_heading = 0.0;
   while (simulator.time() < seconds) {
     outputs.Clear();
-    simulator.Step(&outputs);
+    simulator.Step(&outputs, &truth_now);
     reference.Update(simulator.timestep());
     const double v = reference.linear(), w = reference.angular(), dt = simulator.timestep();
     if (std::abs(w) > 1e-9) {
@@ -72,10 +73,11 @@ TEST(BaseKinematics, TurnOnTheSpot) { DriveAndCompareWithArc(0.0, 0.5, 6.0, 0.02
 
 TEST(SimulatedImu, ReadsGravityAtRestAndTheYawRateInATurn) {
   Simulator simulator(TestConfig(TestLawn(), "imu"));
-  StepOutputs outputs;
+  SensorOutputs outputs;
+  GroundTruth truth_now;
   std::vector<messages::ImuSample> samples;
   while (simulator.time() < 3.0) {
-    simulator.Step(&outputs);
+    simulator.Step(&outputs, &truth_now);
   }
   // Discard the first second (the robot settles on its wheels).
   for (const auto& s : outputs.imu) {
@@ -93,7 +95,7 @@ TEST(SimulatedImu, ReadsGravityAtRestAndTheYawRateInATurn) {
 
   outputs.Clear();
   simulator.SetBaseCommand({0.0, 0.4});
-  while (simulator.time() < 8.0) simulator.Step(&outputs);
+  while (simulator.time() < 8.0) simulator.Step(&outputs, &truth_now);
   double yaw_rate = 0.0;
   int n = 0;
   for (const auto& s : outputs.imu) {
@@ -110,8 +112,9 @@ TEST(WheelEncoders, OdometryOnGrassOverestimatesByTheSlip) {
   config.start = {-4.0, -1.0, 0.0};
   Simulator simulator(config);
   simulator.SetBaseCommand({0.25, 0.0});
-  StepOutputs outputs;
-  while (simulator.time() < 20.0) simulator.Step(&outputs);
+  SensorOutputs outputs;
+  GroundTruth truth_now;
+  while (simulator.time() < 20.0) simulator.Step(&outputs, &truth_now);
   ASSERT_GE(outputs.wheel_ticks.size(), 999u);  // 50 Hz
   const auto& first = outputs.wheel_ticks.front();
   const auto& last = outputs.wheel_ticks.back();
@@ -192,10 +195,11 @@ TEST(Arm, ServosReachAPositionTargetAgainstGravity) {
   messages::ArmCommand command;
   command.position = {0.5, 2.4, 1.2, 4.2, 1.44, 1.32};
   simulator.SetArmCommand(command);
-  StepOutputs outputs;
+  SensorOutputs outputs;
+  GroundTruth truth_now;
   while (simulator.time() < 4.0) {
     outputs.Clear();
-    simulator.Step(&outputs);
+    simulator.Step(&outputs, &truth_now);
   }
   const GroundTruth truth = simulator.ground_truth();
   for (size_t i = 0; i < command.position.size(); ++i) {
@@ -213,12 +217,13 @@ TEST(Contacts, DrivingIntoTheHedgeIsReported) {
   config.start = {6.8, 0.0, 0.0};  // hedge face at x = 8.2, the chassis front 0.58 m ahead
   Simulator simulator(config);
   simulator.SetBaseCommand({0.3, 0.0});
-  StepOutputs outputs;
+  SensorOutputs outputs;
+  GroundTruth truth_now;
   std::vector<ObstacleContact> contacts;
   while (simulator.time() < 8.0 && contacts.empty()) {
     outputs.Clear();
-    simulator.Step(&outputs);
-    contacts = simulator.ObstacleContacts();
+    simulator.Step(&outputs, &truth_now);
+    contacts = truth_now.contacts;
   }
   ASSERT_FALSE(contacts.empty());
   EXPECT_EQ(contacts.front().object_class, garden::ObjectClass::kHedge);

@@ -11,10 +11,15 @@
 #include "sim_test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/stereo.h"
-#include "trimbot/perception/stereo_evaluation.h"
+#include "eval/stereo_evaluation.h"
 #include "trimbot/robot/robot_description.h"
 
 namespace trimbot::perception {
+
+using scenarios::EvaluateDisparity;
+using scenarios::GroundTruthDisparity;
+using scenarios::StereoErrors;
+
 namespace {
 
 using testing::SourcePath;
@@ -262,7 +267,7 @@ TEST_F(RenderedStereo, SgmDisparityMatchesGroundTruth) {
     options.dense = dense;
     const RingStereo stereo(rig, options);
     const auto result = stereo.ComputePair(capture_->frame, 0);
-    const cv::Mat truth = GroundTruthDisparity(stereo.rectifiers()[0], capture_->ground_truth[0].depth);
+    const cv::Mat truth = GroundTruthDisparity(stereo.rectifiers()[0], capture_->truth.views[0].depth);
     const StereoErrors errors = EvaluateDisparity(result.disparity, truth, options.EffectiveDisparities());
     std::printf("pair 0, %d disparities: MAE %.3f px, bad-1 %.2f %%, bad-2 %.2f %%, completeness %.1f %% of %d px, "
                 "spurious %.2f %%\n",
@@ -284,7 +289,7 @@ TEST_F(RenderedStereo, CloudDepthMatchesGroundTruth) {
   const RingStereo stereo(rig);
   const auto result = stereo.ComputePair(capture_->frame, 0);
   const auto& left = rig.camera(0);
-  const cv::Mat& depth = capture_->ground_truth[0].depth;
+  const cv::Mat& depth = capture_->truth.views[0].depth;
   std::vector<double> relative_errors, normalized_errors;
   for (std::size_t i = 0; i < result.cloud.size(); ++i) {
     const Eigen::Vector3d in_left = left.T_base_camera.inverse() * result.cloud.points[i];

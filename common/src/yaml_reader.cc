@@ -1,6 +1,8 @@
 #include "trimbot/common/yaml_reader.h"
 
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 
 namespace trimbot {
 namespace {
@@ -74,6 +76,30 @@ bool YamlMap::Bool(const std::string& key, bool fallback) const {
 }
 std::string YamlMap::String(const std::string& key, const std::string& fallback) const {
   return Has(key) ? String(key) : fallback;
+}
+
+double YamlMap::Number(const std::string& key, double lo, double hi, const std::string& unit) const {
+  const double value = Double(key);
+  const std::string suffix = unit.empty() ? "" : " " + unit;
+  if (!std::isfinite(value)) Fail(key, "must be a finite number");
+  if (value < lo || value > hi) {
+    std::ostringstream range;
+    range << "must be in [" << lo << ", " << hi << "]" << suffix << ", got " << value;
+    Fail(key, range.str());
+  }
+  return value;
+}
+
+double YamlMap::NumberOr(const std::string& key, double fallback, double lo, double hi, const std::string& unit) const {
+  return Has(key) ? Number(key, lo, hi, unit) : fallback;
+}
+
+int YamlMap::Integer(const std::string& key, int lo, int hi) const {
+  const int value = Int(key);
+  if (value < lo || value > hi) {
+    Fail(key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + std::to_string(value));
+  }
+  return value;
 }
 
 std::vector<double> YamlMap::Doubles(const std::string& key, int expected_size) const {

@@ -26,6 +26,30 @@ Shape ParseShape(const YamlMap& map) {
 
 }  // namespace
 
+GardenObject ReadGardenObject(const YamlMap& item) {
+  GardenObject object;
+  object.id = item.Int("id");
+  if (object.id < 1 || object.id > kMaxGardenObjectId) {
+    item.Fail("id", "must be in 1.." + std::to_string(kMaxGardenObjectId));
+  }
+  const std::string class_name = item.String("class");
+  const auto object_class = ObjectClassFromString(class_name);
+  if (!object_class || *object_class == ObjectClass::kNone || *object_class == ObjectClass::kGround ||
+      *object_class == ObjectClass::kRobot) {
+    item.Fail("class", "unknown object class '" + class_name + "' (topiary, rose, hedge, tree, trunk, fence, obstacle)");
+  }
+  object.object_class = *object_class;
+  object.shape = ParseShape(item);
+  object.size = item.Vector3("size");
+  if (!(object.size.minCoeff() > 0.0)) item.Fail("size", "all extents must be positive");
+  const auto position = item.Doubles("position", 2);
+  object.position = {position[0], position[1]};
+  object.base_height = item.Double("base_height", 0.0);
+  object.yaw = item.Double("yaw_deg", 0.0) * kDegToRad;
+  item.RejectUnknownKeys();
+  return object;
+}
+
 Garden Garden::Load(const std::string& path) {
   const YamlMap root = YamlMap::LoadFile(path);
   Garden garden;
@@ -66,28 +90,8 @@ Garden Garden::Load(const std::string& path) {
 
   std::set<int> ids;
   for (const YamlMap& item : root.MapList("objects")) {
-    GardenObject object;
-    object.id = item.Int("id");
-    if (object.id < 1 || object.id > kMaxGardenObjectId) {
-      item.Fail("id", "must be in 1.." + std::to_string(kMaxGardenObjectId));
-    }
+    const GardenObject object = ReadGardenObject(item);
     if (!ids.insert(object.id).second) item.Fail("id", "duplicate id " + std::to_string(object.id));
-    const std::string class_name = item.String("class");
-    const auto object_class = ObjectClassFromString(class_name);
-    if (!object_class || *object_class == ObjectClass::kNone || *object_class == ObjectClass::kGround ||
-        *object_class == ObjectClass::kRobot) {
-      item.Fail("class", "unknown object class '" + class_name +
-                             "' (topiary, rose, hedge, tree, trunk, fence, obstacle)");
-    }
-    object.object_class = *object_class;
-    object.shape = ParseShape(item);
-    object.size = item.Vector3("size");
-    if (!(object.size.minCoeff() > 0.0)) item.Fail("size", "all extents must be positive");
-    const auto position = item.Doubles("position", 2);
-    object.position = {position[0], position[1]};
-    object.base_height = item.Double("base_height", 0.0);
-    object.yaw = item.Double("yaw_deg", 0.0) * kDegToRad;
-    item.RejectUnknownKeys();
     garden.objects.push_back(object);
   }
   root.RejectUnknownKeys();

@@ -75,6 +75,13 @@ Eigen::Isometry3d ReadTransform(const YamlMap& cam, const std::string& key) {
 
 }  // namespace
 
+CameraRig CameraRig::FromCameras(std::vector<CameraCalibration> cameras, std::string source) {
+  CameraRig rig;
+  rig.cameras_ = std::move(cameras);
+  rig.source_ = std::move(source);
+  return rig;
+}
+
 CameraRig CameraRig::LoadKalibr(const std::string& path, const Eigen::Isometry3d& T_base_cam0) {
   const YamlMap root = YamlMap::LoadFile(path);
   CameraRig rig;

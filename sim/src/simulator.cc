@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <chrono>
 #include <cmath>
 
 #include "trimbot/common/input_error.h"
@@ -9,6 +10,7 @@
 #include "trimbot/sim/arm_controller.h"
 #include "trimbot/sim/base_controller.h"
 #include "trimbot/sim/imu_model.h"
+#include "trimbot/sim/ring_renderer.h"
 #include "trimbot/sim/wheel_encoder_model.h"
 #include "trimbot/sim/world.h"
 
@@ -51,21 +53,21 @@ struct Simulator::Impl {
   int imu_steps = 1, encoder_steps = 1, camera_steps = 1;
   double last_left_angle = 0.0, last_right_angle = 0.0;
   garden::SlipModel ground_slip[4];
-  std::unique_ptr<PoseFixModel> pose_fixes;
   std::vector<bool> fault_applied;
-  int end_effector_body = -1;  // looked up once: ground truth is read every step in closed loop
+  int end_effector_body = -1;
+  double render_seconds = 0.0;  // looked up once: ground truth is read every step in closed loop
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
     : config_(config),
-      robot_(robot::RobotDescription::Load(config.urdf_path)),
-      parameters_(robot::RobotParameters::Load(config.robot_parameters_path)),
-      rig_(robot::CameraRig::LoadKalibr(config.calibration_path,
+      robot_(robot::RobotDescription::Load(config.robot.urdf)),
+      parameters_(robot::RobotParameters::Load(config.robot.robot_parameters)),
+      rig_(robot::CameraRig::LoadKalibr(config.robot.camchain,
                                         robot_.FramePose(RobotFrames::CameraOptical(0)))),
       garden_(garden::Garden::Load(config.garden_path)),
       impl_(std::make_unique<Impl>()) {
   if (rig_.size() != 10) {
-    throw InputError(config.calibration_path, "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));
+    throw InputError(config.robot.camchain, "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));
   }
   WorldOptions options;
   options.timestep = config.timestep;
@@ -76,7 +78,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);
   impl_->world = std::make_unique<World>(spec_);
 
-  const std::string& params = config.robot_parameters_path;
+  const std::string& params = config.robot.robot_parameters;
   impl_->imu_steps = StepsPerSample(parameters_.imu.rate_hz, config.timestep, params, "IMU");
   impl_->encoder_steps = StepsPerSample(parameters_.wheel_encoders.rate_hz, config.timestep, params, "wheel encoder");
   impl_->camera_steps = StepsPerSample(parameters_.cameras.rate_hz, config.timestep, params, "camera");
@@ -109,7 +111,6 @@ Simulator::Simulator(const SimulatorConfig& config)
   mj_forward(m, d);
 
   impl_->end_effector_body = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
-  impl_->pose_fixes = std::make_unique<PoseFixModel>(config.pose_fixes, config.seed);
   impl_->fault_applied.assign(config.faults.size(), false);
   if (config.render_cameras) {
     impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.resolution_scale);
@@ -123,6 +124,12 @@ World& Simulator::world() { return *impl_->world; }
 void Simulator::SetBaseCommand(const messages::BaseVelocityCommand& command) { impl_->base->SetCommand(command); }
 void Simulator::SetArmCommand(const messages::ArmCommand& command) { impl_->arm->SetCommand(command); }
 void Simulator::SetCutterCommand(const messages::CutterCommand& command) { impl_->cutter_on = command.on; }
+
+void Simulator::Apply(const messages::RobotCommands& commands) {
+  if (commands.base) SetBaseCommand(*commands.base);
+  if (commands.arm) SetArmCommand(*commands.arm);
+  if (commands.cutter) SetCutterCommand(*commands.cutter);
+}
 
 double Simulator::time() const { return impl_->world->data()->time; }
 
@@ -143,7 +150,7 @@ const garden::SlipModel* Simulator::SurfaceUnder(int wheel_geom) const {
   return nullptr;
 }
 
-void Simulator::Step(StepOutputs* outputs) {
+void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
   World& world = *impl_->world;
   mjModel* m = world.model();
   mjData* d = world.data();
@@ -167,34 +174,52 @@ void Simulator::Step(StepOutputs* outputs) {
   const bool cameras_available = ApplyFaults();
   mj_step(m, d);
   ++impl_->step;
+  ReadSensors(stamp_before, sensors);
 
+  const bool ring_exposed = cameras_available && impl_->step % impl_->camera_steps == 0;
+  std::optional<RingCapture> capture;
+  if (ring_exposed && impl_->renderer && config_.cameras_on_schedule) {
+    const int every = config_.ground_truth_every_frames;
+    capture = CaptureRing(every > 0 && impl_->frame % every == 0);
+  }
+  *truth = ground_truth();
+  truth->contacts = ObstacleContacts();
+  truth->ring_exposed = ring_exposed;
+  if (capture) {
+    sensors->ring = std::move(capture->frame);
+    truth->ring = std::move(capture->truth);
+  }
+}
+
+void Simulator::ReadSensors(double stamp_before, SensorOutputs* sensors) {
+  World& world = *impl_->world;
+  const mjData* d = world.data();
   // IMU: MuJoCo's sensors were evaluated at the start of the step.
   if (impl_->step % impl_->imu_steps == 0) {
     const Eigen::Map<const Eigen::Vector3d> accel(d->sensordata + world.accelerometer_adr());
     const Eigen::Map<const Eigen::Vector3d> gyro(d->sensordata + world.gyro_adr());
-    outputs->imu.push_back(impl_->imu->Measure(stamp_before, accel, gyro, impl_->imu_steps * dt));
+    sensors->imu.push_back(impl_->imu->Measure(stamp_before, accel, gyro, impl_->imu_steps * config_.timestep));
   }
 
   // Encoders integrate every step (slip depends on the surface under each wheel).
   const double left_angle = d->qpos[world.left_wheel().qpos];
   const double right_angle = d->qpos[world.right_wheel().qpos];
-  impl_->encoders->Advance(dt, left_angle - impl_->last_left_angle, right_angle - impl_->last_right_angle,
+  impl_->encoders->Advance(config_.timestep, left_angle - impl_->last_left_angle, right_angle - impl_->last_right_angle,
                            SurfaceUnder(world.left_wheel_geom()), SurfaceUnder(world.right_wheel_geom()));
   impl_->last_left_angle = left_angle;
   impl_->last_right_angle = right_angle;
-  if (impl_->step % impl_->encoder_steps == 0) outputs->wheel_ticks.push_back(impl_->encoders->Read(d->time));
-
-  if (cameras_available && impl_->step % impl_->camera_steps == 0) {
-    if (impl_->renderer && config_.cameras_on_schedule) {
-      const int every = config_.ground_truth_every_frames;
-      outputs->ring = CaptureRing(every > 0 && impl_->frame % every == 0);
+  if (impl_->step % impl_->encoder_steps == 0) {
+    sensors->wheel_ticks.push_back(impl_->encoders->Read(d->time));
+    // The arm's joint encoders report with the wheels' (the Jaco's firmware is far finer than the
+    // controllers' errors, so no noise is modelled).
+    messages::ArmJointState joints;
+    joints.stamp = d->time;
+    for (size_t i = 0; i < joints.position.size(); ++i) {
+      joints.position[i] = d->qpos[world.arm()[i].qpos];
+      joints.velocity[i] = d->qvel[world.arm()[i].dof];
     }
-    const Eigen::Isometry3d T_map_base = ground_truth().T_map_base;
-    const Eigen::Vector3d x_axis = T_map_base.linear().col(0);
-    impl_->pose_fixes->Capture(d->time, T_map_base.translation().x(), T_map_base.translation().y(),
-                               std::atan2(x_axis.y(), x_axis.x()));
+    sensors->arm_joints.push_back(joints);
   }
-  impl_->pose_fixes->Deliver(d->time, &outputs->pose_fixes);
 }
 
 bool Simulator::ApplyFaults() {
@@ -226,12 +251,17 @@ bool Simulator::ApplyFaults() {
   return cameras_available;
 }
 
+double Simulator::render_seconds() const { return impl_->render_seconds; }
+long Simulator::rendered_frames() const { return impl_->frame; }
+
 RingCapture Simulator::CaptureRing(bool with_ground_truth) {
   if (!impl_->renderer) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
+  const auto start = std::chrono::steady_clock::now();
   World& world = *impl_->world;
   mj_forward(world.model(), world.data());  // kinematics at the current time
   RingCapture capture;
   capture.frame.stamp = world.data()->time;
+  RingTruth& truth = capture.truth;
   for (int i = 0; i < rig_.size(); ++i) {
     RenderedView view = impl_->renderer->Render(i, with_ground_truth);
     // Sensor noise, seeded per frame and camera so each image is reproducible on its own.
@@ -255,10 +285,11 @@ RingCapture Simulator::CaptureRing(bool with_ground_truth) {
     const int id = world.camera_id(i);
     Eigen::Isometry3d T_map_camera = PoseFromMujoco(world.data()->cam_xpos + 3 * id, world.data()->cam_xmat + 9 * id);
     T_map_camera.linear() = T_map_camera.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-    capture.T_map_camera.push_back(T_map_camera);
-    if (with_ground_truth) capture.ground_truth.push_back(std::move(view));
+    truth.T_map_camera.push_back(T_map_camera);
+    if (with_ground_truth) truth.views.push_back(std::move(view));
   }
   ++impl_->frame;
+  impl_->render_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return capture;
 }
 

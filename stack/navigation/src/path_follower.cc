@@ -30,6 +30,20 @@ void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path) {
   aligned_ = false;
 }
 
+Eigen::Vector2d PathFollower::LookaheadPoint(double fraction, std::size_t stretch_end) const {
+  // Walk `lookahead` metres along the path from the closest point, not past the end of the stretch.
+  if (path_.size() < 2) return path_[stretch_end];
+  double remaining = parameters_.lookahead;
+  Eigen::Vector2d from = path_[segment_] + fraction * (path_[segment_ + 1] - path_[segment_]);
+  for (std::size_t s = segment_; s < stretch_end; ++s) {
+    const double length = (path_[s + 1] - from).norm();
+    if (length >= remaining) return from + remaining * (path_[s + 1] - from) / length;
+    remaining -= length;
+    from = path_[s + 1];
+  }
+  return path_[stretch_end];
+}
+
 FollowerOutput PathFollower::Update(const Pose2& pose) {
   FollowerOutput out;
   if (path_.empty()) {
@@ -70,22 +84,7 @@ FollowerOutput PathFollower::Update(const Pose2& pose) {
   segment_ = best_segment;
   out.deviation = best;
 
-  // Lookahead point: walk `lookahead` metres along the path from the closest point, not past the
-  // end of the stretch.
-  Eigen::Vector2d target = path_[stretch_end];
-  if (path_.size() > 1) {
-    double remaining = parameters_.lookahead;
-    Eigen::Vector2d from = path_[segment_] + best_fraction * (path_[segment_ + 1] - path_[segment_]);
-    for (std::size_t s = segment_; s < stretch_end; ++s) {
-      const double length = (path_[s + 1] - from).norm();
-      if (length >= remaining) {
-        target = from + remaining * (path_[s + 1] - from) / length;
-        break;
-      }
-      remaining -= length;
-      from = path_[s + 1];
-    }
-  }
+  const Eigen::Vector2d target = LookaheadPoint(best_fraction, stretch_end);
   const double distance_to_stop = (path_[stretch_end] - position).norm();
 
   // Target in base_link.

@@ -124,32 +124,34 @@ Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& w) {
 
 }  // namespace
 
-double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
-  const Eigen::Matrix3d delta = estimate.linear().transpose() * truth.linear();
-  const double c = std::clamp((delta.trace() - 1.0) / 2.0, -1.0, 1.0);
-  return std::acos(c) * 180.0 / M_PI;
-}
+namespace {
 
-double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
-  return (estimate.translation() - truth.translation()).norm();
-}
+// The clouds as registration uses them: cleaned, covariances scaled, and a pyramid of voxel
+// levels of the target (with a k-d tree each) and of the source.
+struct Prepared {
+  PointCloud target, source;
+  double point_spacing = 0.0;           // median nearest-neighbour distance in the target
+  bool isotropic = true;                // every covariance is c I
+  double typical_target_variance = 0.0;
+  std::deque<TargetLevel> levels;       // a deque: growing it never moves a level its tree points into
+  std::vector<PointCloud> source_levels;
+};
 
-RegistrationResult Register(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
-                            const RegistrationOptions& options) {
-  if (!initial.matrix().allFinite()) throw RegistrationError("registration: the initial guess is not finite");
-  RegistrationResult result;
-  PointCloud target = CleanCloud(target_in, options.max_variance, &result.target_points);
-  PointCloud source = CleanCloud(source_in, options.max_variance, &result.source_points);
+void Prepare(const PointCloud& target_in, const PointCloud& source_in, const RegistrationOptions& options,
+             RegistrationResult* result, Prepared* p) {
+  p->target = CleanCloud(target_in, options.max_variance, &result->target_points);
+  p->source = CleanCloud(source_in, options.max_variance, &result->source_points);
+  PointCloud& target = p->target;
+  PointCloud& source = p->source;
   if (target.size() < 3 || source.size() < 3) {
     throw RegistrationError("registration: needs at least 3 usable points in each cloud (target " +
                             std::to_string(target.size()) + " of " + std::to_string(target_in.size()) + ", source " +
                             std::to_string(source.size()) + " of " + std::to_string(source_in.size()) + ")");
   }
-
-  std::deque<TargetLevel> levels(1);  // a deque: growing it never moves a level its tree points into
-  levels[0].cloud = target;
-  levels[0].Build();
-  const KdTree& tree = *levels[0].tree;
+  p->levels.resize(1);
+  p->levels[0].cloud = target;
+  p->levels[0].Build();
+  const KdTree& tree = *p->levels[0].tree;
 
   // Median spacing of the target (nearest other point), the scale of "close".
   std::vector<double> spacing;
@@ -158,158 +160,205 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
     double d2[2];
     if (tree.knnSearch(target.points[i].data(), 2, index, d2) == 2) spacing.push_back(std::sqrt(d2[1]));
   }
-  const double point_spacing = std::max(Median(spacing), 1e-6);
+  p->point_spacing = std::max(Median(spacing), 1e-6);
 
   if (options.relative_covariances) {
     std::vector<double> variances;
     for (const auto& c : target.covariances) variances.push_back(c.trace() / 3.0);
-    const double scale = point_spacing * point_spacing / std::max(Median(variances), 1e-300);
+    const double scale = p->point_spacing * p->point_spacing / std::max(Median(variances), 1e-300);
     for (auto& c : target.covariances) c *= scale;
     for (auto& c : source.covariances) c *= scale;
   }
-  bool isotropic = true;
-  for (const auto& c : target.covariances) isotropic = isotropic && IsIsotropic(c);
-  for (const auto& c : source.covariances) isotropic = isotropic && IsIsotropic(c);
+  for (const auto& c : target.covariances) p->isotropic = p->isotropic && IsIsotropic(c);
+  for (const auto& c : source.covariances) p->isotropic = p->isotropic && IsIsotropic(c);
   std::vector<double> target_variances;
   for (const auto& c : target.covariances) target_variances.push_back(c.trace() / 3.0);
-  const double typical_target_variance = Median(target_variances);
+  p->typical_target_variance = Median(target_variances);
 
-  levels[0].cloud.covariances = target.covariances;  // scaled above
-  for (double voxel = 4.0 * point_spacing; voxel <= 1.0; voxel *= 2.0) {
+  p->levels[0].cloud.covariances = target.covariances;  // scaled above
+  for (double voxel = 4.0 * p->point_spacing; voxel <= 1.0; voxel *= 2.0) {
     PointCloud coarse = VoxelDownsample(target, voxel);
     if (coarse.size() < 50) break;
-    TargetLevel& level = levels.emplace_back();  // built in place: its tree refers to its points
+    TargetLevel& level = p->levels.emplace_back();  // built in place: its tree refers to its points
     level.voxel = voxel;
     level.cloud = std::move(coarse);
     level.Build();
   }
-
-  Eigen::Isometry3d T = initial;
-  double anneal = options.anneal_start;
-  if (anneal < 0.0) {
-    std::vector<double> distances;
-    for (std::size_t j = 0; j < source.size(); j += std::max<std::size_t>(1, source.size() / 2000)) {
-      const Eigen::Vector3d y = T * source.points[j];
-      std::uint32_t index;
-      double d2;
-      tree.knnSearch(y.data(), 1, &index, &d2);
-      distances.push_back(std::sqrt(d2));
-    }
-    // Points on a plane find near neighbours whatever the misalignment along it, so the spread
-    // also starts at a fraction of the target's size.
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const auto& p : target.points) centroid += p;
-    centroid /= static_cast<double>(target.size());
-    double spread2 = 0.0;
-    for (const auto& p : target.points) spread2 += (p - centroid).squaredNorm();
-    const double rms_radius = std::sqrt(spread2 / static_cast<double>(target.size()));
-    anneal = std::clamp(std::max(Median(distances), 0.3 * rms_radius), point_spacing, 1.0);
-  }
-
-  const bool icp = options.method == RegistrationMethod::kIcp;
-  const int k = icp ? 1 : std::max(1, options.neighbours);
-  const double gate2 = options.truncation_sigmas * options.truncation_sigmas;
   // The source at each level's resolution too: while the spread is wide, fewer source points
   // carry the same information, and the early iterations cost a fraction of the late ones.
-  std::vector<PointCloud> source_levels(levels.size());
-  source_levels[0] = source;
+  p->source_levels.resize(p->levels.size());
+  p->source_levels[0] = source;
   if (options.max_source_points > 0 && source.size() > static_cast<std::size_t>(options.max_source_points)) {
     // Every k-th point: the target keeps its full density, which is what the accuracy rests on.
     const std::size_t stride = (source.size() + options.max_source_points - 1) / options.max_source_points;
     PointCloud thinned;
     for (std::size_t j = 0; j < source.size(); j += stride) thinned.Add(source.points[j], source.covariances[j]);
-    source_levels[0] = std::move(thinned);
+    p->source_levels[0] = std::move(thinned);
   }
-  for (std::size_t l = 1; l < levels.size(); ++l) source_levels[l] = VoxelDownsample(source, levels[l].voxel);
-  std::vector<SourceTerms> terms(source.size());
+  for (std::size_t l = 1; l < p->levels.size(); ++l) p->source_levels[l] = VoxelDownsample(source, p->levels[l].voxel);
+}
 
-  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    const Eigen::Matrix3d R = T.linear();
-    const Eigen::Vector3d t = T.translation();
-    const double spread2 = 2.0 * anneal * anneal;
-    // ICP rejects pairs farther than 3 annealing spreads (at least 3 point spacings).
-    const double icp_reject2 = std::pow(3.0 * std::max(anneal, point_spacing), 2);
-    // The coarsest target whose voxels are no wider than the spread (ICP: always the full cloud).
-    std::size_t level_index = 0;
-    while (!icp && level_index + 1 < levels.size() && levels[level_index + 1].voxel <= anneal) ++level_index;
-    const TargetLevel& level = levels[level_index];
-    const PointCloud& moving = icp ? source : source_levels[level_index];
-    terms.resize(moving.size());
+// The annealing spread to start from: the typical distance of the source (at the initial guess)
+// to the target, and at least a fraction of the target's size.
+double InitialSpread(const Prepared& p, const Eigen::Isometry3d& T) {
+  std::vector<double> distances;
+  for (std::size_t j = 0; j < p.source.size(); j += std::max<std::size_t>(1, p.source.size() / 2000)) {
+    const Eigen::Vector3d y = T * p.source.points[j];
+    std::uint32_t index;
+    double d2;
+    p.levels[0].tree->knnSearch(y.data(), 1, &index, &d2);
+    distances.push_back(std::sqrt(d2));
+  }
+  // Points on a plane find near neighbours whatever the misalignment along it, so the spread
+  // also starts at a fraction of the target's size.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& point : p.target.points) centroid += point;
+  centroid /= static_cast<double>(p.target.size());
+  double spread2 = 0.0;
+  for (const auto& point : p.target.points) spread2 += (point - centroid).squaredNorm();
+  const double rms_radius = std::sqrt(spread2 / static_cast<double>(p.target.size()));
+  return std::clamp(std::max(Median(distances), 0.3 * rms_radius), p.point_spacing, 1.0);
+}
 
-    // E-step, in parallel over source points; each writes only its own terms (deterministic).
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(moving.size()); ++jj) {
-      const std::size_t j = static_cast<std::size_t>(jj);
-      SourceTerms& term = terms[j];
-      term = SourceTerms{};
-      const Eigen::Vector3d y = R * moving.points[j] + t;
-      std::uint32_t index[64];
-      double d2[64];
-      const std::size_t found = level.tree->knnSearch(y.data(), static_cast<std::size_t>(std::min(k, 64)), index, d2);
-      if (icp) {
-        if (found == 0 || d2[0] > icp_reject2) continue;
-        term.weight = 1.0;
-        term.weighted_target = level.cloud.points[index[0]];
-        term.cost = d2[0];
-        term.pairs = 1;
-        continue;
+// What one E-step iteration needs to score one source point against a target level.
+struct EStep {
+  const TargetLevel& level;
+  const PointCloud& moving;
+  Eigen::Matrix3d R;
+  Eigen::Vector3d t;
+  bool icp = false, isotropic = true;
+  int k = 1;
+  double spread2 = 0.0, icp_reject2 = 0.0, gate2 = 0.0, typical_target_variance = 0.0, outlier_weight = 0.0;
+
+  // The pair terms of source point j (posterior weights of its k nearest target points).
+  SourceTerms Terms(std::size_t j) const {
+    SourceTerms term;
+    const Eigen::Vector3d y = R * moving.points[j] + t;
+    std::uint32_t index[64];
+    double d2[64];
+    const std::size_t found = level.tree->knnSearch(y.data(), static_cast<std::size_t>(std::min(k, 64)), index, d2);
+    if (icp) {
+      if (found == 0 || d2[0] > icp_reject2) return term;
+      term.weight = 1.0;
+      term.weighted_target = level.cloud.points[index[0]];
+      term.cost = d2[0];
+      term.pairs = 1;
+      return term;
+    }
+    const Eigen::Matrix3d source_cov = R * moving.covariances[j] * R.transpose();
+    // Outlier term: the density of a pair at the truncation distance with typical covariances.
+    const Eigen::Matrix3d typical = source_cov + (typical_target_variance + spread2) * Eigen::Matrix3d::Identity();
+    const double outlier = outlier_weight * std::exp(-0.5 * gate2) / std::sqrt(typical.determinant());
+    double weights[64];
+    Eigen::Matrix3d informations[64];
+    double total = 0.0;
+    for (std::size_t n = 0; n < found; ++n) {
+      const Eigen::Vector3d d = level.cloud.points[index[n]] - y;
+      double m = 0.0, determinant = 0.0;
+      if (isotropic) {  // C = c I: no 3x3 inverse per pair
+        const double c = level.cloud.covariances[index[n]](0, 0) + source_cov(0, 0) + spread2;
+        informations[n] = Eigen::Matrix3d::Identity() / c;
+        m = d.squaredNorm() / c;
+        determinant = c * c * c;
+      } else {
+        const Eigen::Matrix3d C = level.cloud.covariances[index[n]] + source_cov + spread2 * Eigen::Matrix3d::Identity();
+        informations[n] = C.inverse();
+        m = d.dot(informations[n] * d);
+        determinant = C.determinant();
       }
-      const Eigen::Matrix3d source_cov = R * moving.covariances[j] * R.transpose();
-      // Outlier term: the density of a pair at the truncation distance with typical covariances.
-      const Eigen::Matrix3d typical = source_cov + (typical_target_variance + spread2) * Eigen::Matrix3d::Identity();
-      const double outlier = options.outlier_weight * std::exp(-0.5 * gate2) / std::sqrt(typical.determinant());
-      double weights[64];
-      Eigen::Matrix3d informations[64];
-      double total = 0.0;
-      for (std::size_t n = 0; n < found; ++n) {
-        const Eigen::Vector3d d = level.cloud.points[index[n]] - y;
-        double m = 0.0, determinant = 0.0;
-        if (isotropic) {  // C = c I: no 3x3 inverse per pair
-          const double c = level.cloud.covariances[index[n]](0, 0) + source_cov(0, 0) + spread2;
-          informations[n] = Eigen::Matrix3d::Identity() / c;
-          m = d.squaredNorm() / c;
-          determinant = c * c * c;
-        } else {
-          const Eigen::Matrix3d C = level.cloud.covariances[index[n]] + source_cov + spread2 * Eigen::Matrix3d::Identity();
-          informations[n] = C.inverse();
-          m = d.dot(informations[n] * d);
-          determinant = C.determinant();
-        }
-        weights[n] = m > gate2 ? 0.0 : std::exp(-0.5 * m) / std::sqrt(determinant);
-        total += weights[n];
-      }
-      if (total <= 0.0) continue;
-      Eigen::Matrix3d information_sum = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d weighted_residual = Eigen::Vector3d::Zero();
-      for (std::size_t n = 0; n < found; ++n) {
-        if (weights[n] <= 0.0) continue;
-        const double w = weights[n] / (total + outlier);  // posterior of the pair
-        const Eigen::Vector3d& x = level.cloud.points[index[n]];
-        const Eigen::Vector3d r = x - y;
-        term.cost += w * r.dot(informations[n] * r);
-        ++term.pairs;
-        if (isotropic) {
-          const double omega = w * informations[n](0, 0);
-          term.weight += omega;
-          term.weighted_target += omega * x;
-        } else {
-          information_sum += w * informations[n];
-          weighted_residual += w * informations[n] * r;
-          term.weight += w;
-        }
-      }
-      if (!isotropic && term.weight > 0.0) {
-        // r(delta) = x - (exp(dtheta) R y_src + t + dt): J = [ [R y_src]x , -I ], the same for all
-        // of this point's pairs, so their information sums before the 6x6 products.
-        Eigen::Matrix<double, 3, 6> J;
-        J.leftCols<3>() = Skew(R * moving.points[j]);
-        J.rightCols<3>() = -Eigen::Matrix3d::Identity();
-        term.H = J.transpose() * information_sum * J;
-        term.g = J.transpose() * weighted_residual;
+      weights[n] = m > gate2 ? 0.0 : std::exp(-0.5 * m) / std::sqrt(determinant);
+      total += weights[n];
+    }
+    if (total <= 0.0) return term;
+    Accumulate(j, y, index, found, weights, informations, total + outlier, &term);
+    return term;
+  }
+
+  void Accumulate(std::size_t j, const Eigen::Vector3d& y, const std::uint32_t* index, std::size_t found,
+                  const double* weights, const Eigen::Matrix3d* informations, double normalizer,
+                  SourceTerms* term) const {
+    Eigen::Matrix3d information_sum = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d weighted_residual = Eigen::Vector3d::Zero();
+    for (std::size_t n = 0; n < found; ++n) {
+      if (weights[n] <= 0.0) continue;
+      const double w = weights[n] / normalizer;  // posterior of the pair
+      const Eigen::Vector3d& x = level.cloud.points[index[n]];
+      const Eigen::Vector3d r = x - y;
+      term->cost += w * r.dot(informations[n] * r);
+      ++term->pairs;
+      if (isotropic) {
+        const double omega = w * informations[n](0, 0);
+        term->weight += omega;
+        term->weighted_target += omega * x;
+      } else {
+        information_sum += w * informations[n];
+        weighted_residual += w * informations[n] * r;
+        term->weight += w;
       }
     }
+    if (!isotropic && term->weight > 0.0) {
+      // r(delta) = x - (exp(dtheta) R y_src + t + dt): J = [ [R y_src]x , -I ], the same for all
+      // of this point's pairs, so their information sums before the 6x6 products.
+      Eigen::Matrix<double, 3, 6> J;
+      J.leftCols<3>() = Skew(R * moving.points[j]);
+      J.rightCols<3>() = -Eigen::Matrix3d::Identity();
+      term->H = J.transpose() * information_sum * J;
+      term->g = J.transpose() * weighted_residual;
+    }
+  }
+};
 
-    // M-step.
+// M-step: the transform that best explains the pairs (weighted Kabsch when every covariance is
+// isotropic or for ICP, else one Gauss-Newton step on SE(3)).
+Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud& moving, const Eigen::Isometry3d& T,
+                        bool closed_form, int pairs) {
+  if (closed_form) return WeightedKabsch(terms, moving.points);
+  Eigen::Isometry3d next = T;
+  Matrix6 H = Matrix6::Zero();
+  Vector6 g = Vector6::Zero();
+  for (const auto& term : terms) {
+    H += term.H;
+    g += term.g;
+  }
+  if (pairs > 0) {
+    const Vector6 delta = -(H + 1e-9 * Matrix6::Identity()).ldlt().solve(g);
+    if (delta.allFinite()) {
+      next.linear() = ExpSO3(delta.head<3>()) * T.linear();
+      next.translation() = T.translation() + delta.tail<3>();
+    }
+  }
+  return next;
+}
+
+}  // namespace
+
+RegistrationResult Register(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
+                            const RegistrationOptions& options) {
+  if (!initial.matrix().allFinite()) throw RegistrationError("registration: the initial guess is not finite");
+  RegistrationResult result;
+  Prepared p;
+  Prepare(target_in, source_in, options, &result, &p);
+  Eigen::Isometry3d T = initial;
+  double anneal = options.anneal_start < 0.0 ? InitialSpread(p, T) : options.anneal_start;
+  const bool icp = options.method == RegistrationMethod::kIcp;
+  std::vector<SourceTerms> terms(p.source.size());
+
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    // The coarsest target whose voxels are no wider than the spread (ICP: always the full cloud).
+    std::size_t level_index = 0;
+    while (!icp && level_index + 1 < p.levels.size() && p.levels[level_index + 1].voxel <= anneal) ++level_index;
+    const PointCloud& moving = icp ? p.source : p.source_levels[level_index];
+    // ICP rejects pairs farther than 3 annealing spreads (at least 3 point spacings).
+    const EStep e{p.levels[level_index], moving, T.linear(), T.translation(), icp, p.isotropic,
+                  icp ? 1 : std::max(1, options.neighbours), 2.0 * anneal * anneal,
+                  std::pow(3.0 * std::max(anneal, p.point_spacing), 2),
+                  options.truncation_sigmas * options.truncation_sigmas, p.typical_target_variance, options.outlier_weight};
+    terms.resize(moving.size());
+    // E-step, in parallel over source points; each writes only its own terms (deterministic).
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t j = 0; j < static_cast<std::ptrdiff_t>(moving.size()); ++j) {
+      terms[static_cast<std::size_t>(j)] = e.Terms(static_cast<std::size_t>(j));
+    }
     double cost = 0.0;
     int matched = 0;  // source points with at least one pair
     int pairs = 0;
@@ -318,41 +367,20 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
       matched += term.weight > 0.0 ? 1 : 0;
       pairs += term.pairs;
     }
-    Eigen::Isometry3d next = T;
-    if (icp || isotropic) {
-      next = WeightedKabsch(terms, moving.points);
-    } else {
-      Matrix6 H = Matrix6::Zero();
-      Vector6 g = Vector6::Zero();
-      for (const auto& term : terms) {
-        H += term.H;
-        g += term.g;
-      }
-      if (pairs > 0) {
-        const Vector6 delta = -(H + 1e-9 * Matrix6::Identity()).ldlt().solve(g);
-        if (delta.allFinite()) {
-          next.linear() = ExpSO3(delta.head<3>()) * T.linear();
-          next.translation() = T.translation() + delta.tail<3>();
-        }
-      }
-    }
-    if (pairs == 0 || !next.matrix().allFinite()) {
-      result.iterations = iteration + 1;
-      break;  // nothing matched: keep the last transform rather than invent one
-    }
+    const Eigen::Isometry3d next = MStep(terms, moving, T, icp || p.isotropic, pairs);
+    result.iterations = iteration + 1;
+    if (pairs == 0 || !next.matrix().allFinite()) break;  // nothing matched: keep the last transform
     const double step = std::acos(std::clamp(((next.linear().transpose() * T.linear()).trace() - 1.0) / 2.0, -1.0, 1.0)) +
                         (next.translation() - T.translation()).norm();
     T = next;
-    result.iterations = iteration + 1;
     result.final_cost = matched > 0 ? cost / matched : 0.0;
     result.pairs = pairs;
-    const bool annealed = anneal == 0.0;
-    if (step < options.tolerance && annealed) {
+    if (step < options.tolerance && anneal == 0.0) {
       result.converged = true;
       break;
     }
     anneal *= options.anneal_factor;
-    if (anneal < 0.5 * point_spacing) anneal = 0.0;  // below the point spacing the points' own covariances rule
+    if (anneal < 0.5 * p.point_spacing) anneal = 0.0;  // below the point spacing the points' own covariances rule
   }
   // Re-orthonormalize against accumulated rounding.
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.linear(), Eigen::ComputeFullU | Eigen::ComputeFullV);

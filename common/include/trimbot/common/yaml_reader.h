@@ -35,6 +35,11 @@ class YamlMap {
   bool Bool(const std::string& key, bool fallback) const;
   std::string String(const std::string& key, const std::string& fallback) const;
 
+  // Checked numbers: finite and within [lo, hi] (`unit` is named in the message, e.g. "m").
+  double Number(const std::string& key, double lo, double hi, const std::string& unit = "") const;
+  double NumberOr(const std::string& key, double fallback, double lo, double hi, const std::string& unit = "") const;
+  int Integer(const std::string& key, int lo, int hi) const;
+
   // Throws InputError naming the first key that was never read. Call after reading all keys.
   void RejectUnknownKeys() const;
   // Error about this map or one of its keys, with file and line.

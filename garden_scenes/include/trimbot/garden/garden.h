@@ -8,6 +8,10 @@
 
 #include "trimbot/garden/object_class.h"
 
+namespace trimbot {
+class YamlMap;
+}
+
 namespace trimbot::garden {
 
 enum class Shape { kBox, kCylinder, kEllipsoid };
@@ -51,5 +55,9 @@ struct Garden {
 };
 
 bool IsFoliage(ObjectClass c);
+
+// One object as a garden file writes it ({id, class, shape, size, position, base_height, yaw_deg}).
+// Throws InputError naming the file, line and key.
+GardenObject ReadGardenObject(const YamlMap& item);
 
 }  // namespace trimbot::garden

@@ -45,6 +45,8 @@ class CameraRig {
   // Throws InputError naming the file and the problem.
   static CameraRig LoadKalibr(const std::string& camchain_path, const Eigen::Isometry3d& T_base_cam0);
   std::string ToKalibrYaml() const;
+  // A rig of these cameras (e.g. a perturbed copy of a loaded one); `source` names where it came from.
+  static CameraRig FromCameras(std::vector<CameraCalibration> cameras, std::string source);
 
   const std::vector<CameraCalibration>& cameras() const { return cameras_; }
   const CameraCalibration& camera(int index) const { return cameras_.at(static_cast<size_t>(index)); }

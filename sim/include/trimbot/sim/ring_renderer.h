@@ -10,16 +10,10 @@
 
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/sim/render_pinhole.h"
+#include "trimbot/sim/rendered_view.h"
 #include "trimbot/sim/world.h"
 
 namespace trimbot::sim {
-
-struct RenderedView {
-  cv::Mat rgb;           // CV_8UC3, RGB order, calibrated (distorted) image
-  cv::Mat depth;         // CV_32F, metres along the optical axis; 0 where nothing was hit
-  cv::Mat object_class;  // CV_8U, garden::ObjectClass
-  cv::Mat object_id;     // CV_16U, garden object id (see garden/object_class.h)
-};
 
 class RingRenderer {
  public:

@@ -1,11 +1,13 @@
 #pragma once
 // The simulated robot in its garden, as one system with explicit inputs, outputs and state:
 //   inputs   base velocity command, arm command, cutter command
-//   outputs  sensor messages (IMU, wheel ticks, ring frames) - what the stack may see
-//   state    MuJoCo state + sensor-model state; ground truth is read separately and goes only to
-//            the evaluation.
+//   outputs  SensorOutputs - the sensor messages the robot's drivers deliver (what the stack sees)
+//            GroundTruth   - the true state, contacts and the renderer's depth and labels; it goes
+//                            to the evaluation only, never to the stack
+//   state    MuJoCo state + sensor-model state.
 // Time advances in fixed physics steps; every sensor runs at an integer number of steps, and all
-// noise comes from streams seeded by `seed`, so a run is reproduced exactly by its seed.
+// noise comes from streams seeded by `seed`, so a run is reproduced exactly by its seed. This
+// header shows no MuJoCo or OpenGL: those stay inside sim/.
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
@@ -20,18 +22,18 @@
 #include "trimbot/messages/sensor_messages.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/robot/robot_parameters.h"
 #include "trimbot/sim/faults.h"
-#include "trimbot/sim/pose_fix_model.h"
-#include "trimbot/sim/ring_renderer.h"
+#include "trimbot/sim/rendered_view.h"
 #include "trimbot/sim/world_builder.h"
 
 namespace trimbot::sim {
 
+class World;
+
 struct SimulatorConfig {
-  std::string urdf_path;
-  std::string calibration_path;      // Kalibr camchain: the cameras as they really are
-  std::string robot_parameters_path;
+  robot::RobotFiles robot;           // urdf, camchain (the cameras as they really are), parameters
   std::string garden_path;
   std::string world_dir;             // where world.xml and its textures are written
   std::uint64_t seed = 0;
@@ -43,10 +45,36 @@ struct SimulatorConfig {
   int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
   double resolution_scale = 1.0;     // 0.5 renders half-resolution images
   int msaa_samples = 4;              // anti-aliasing; 0 halves the render time, edges get jagged
-  PoseFixModelParameters pose_fixes; // stand-in for visual localization (off by default)
   double imu_noise_scale = 1.0;      // multiplies every IMU noise parameter
   double wheel_slip_scale = 1.0;     // multiplies the surfaces' slip (mean and spread)
   std::vector<Fault> faults;         // injected at their times
+};
+
+// What the robot's drivers deliver in one physics step.
+struct SensorOutputs {
+  std::vector<messages::ImuSample> imu;
+  std::vector<messages::WheelTicks> wheel_ticks;
+  std::vector<messages::ArmJointState> arm_joints;
+  std::optional<messages::RingFrame> ring;   // noisy images, when the ring was rendered this step
+  void Clear() {
+    imu.clear();
+    wheel_ticks.clear();
+    arm_joints.clear();
+    ring.reset();
+  }
+};
+
+// A contact between the robot and a garden object other than the ground.
+struct ObstacleContact {
+  std::string robot_geom;
+  std::string object_geom;
+  garden::ObjectClass object_class = garden::ObjectClass::kNone;
+};
+
+// The renderer's truth about one ring frame.
+struct RingTruth {
+  std::vector<RenderedView> views;              // depth/labels on ground-truth frames, else empty
+  std::vector<Eigen::Isometry3d> T_map_camera;  // true optical-frame poses
 };
 
 // Ground truth at the current time, in the map frame (MuJoCo's world frame).
@@ -59,32 +87,16 @@ struct GroundTruth {
   Eigen::Isometry3d T_map_end_effector = Eigen::Isometry3d::Identity();
   Eigen::Vector3d accelerometer_bias = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyroscope_bias = Eigen::Vector3d::Zero();
-};
-
-// A contact between the robot and a garden object other than the ground.
-struct ObstacleContact {
-  std::string robot_geom;
-  std::string object_geom;
-  garden::ObjectClass object_class = garden::ObjectClass::kNone;
+  // The ring's cameras were triggered in this step and deliver images (no dropout), whether or
+  // not they were rendered: what an image-driven source (or its simulated stand-in) works from.
+  bool ring_exposed = false;
+  std::optional<RingTruth> ring;                // with SensorOutputs::ring
+  std::vector<ObstacleContact> contacts;        // robot against garden objects, now
 };
 
 struct RingCapture {
-  messages::RingFrame frame;                      // sensor output (noisy images)
-  std::vector<RenderedView> ground_truth;         // depth/labels on ground-truth frames, else empty
-  std::vector<Eigen::Isometry3d> T_map_camera;    // true optical-frame poses
-};
-
-struct StepOutputs {
-  std::vector<messages::ImuSample> imu;
-  std::vector<messages::WheelTicks> wheel_ticks;
-  std::optional<RingCapture> ring;
-  std::vector<messages::PoseFix> pose_fixes;
-  void Clear() {
-    imu.clear();
-    wheel_ticks.clear();
-    ring.reset();
-    pose_fixes.clear();
-  }
+  messages::RingFrame frame;   // sensor output (noisy images)
+  RingTruth truth;
 };
 
 class Simulator {
@@ -96,14 +108,16 @@ class Simulator {
   void SetBaseCommand(const messages::BaseVelocityCommand& command);
   void SetArmCommand(const messages::ArmCommand& command);
   void SetCutterCommand(const messages::CutterCommand& command);
+  void Apply(const messages::RobotCommands& commands);
 
-  // One physics step; sensor messages due in it are appended to `outputs`.
-  void Step(StepOutputs* outputs);
+  // One physics step: the sensor messages due in it are appended to `sensors`; `truth` is set to
+  // the ground truth after the step.
+  void Step(SensorOutputs* sensors, GroundTruth* truth);
   double time() const;
   double timestep() const { return config_.timestep; }
 
+  // Ground truth now (without a ring frame).
   GroundTruth ground_truth() const;
-  std::vector<ObstacleContact> ObstacleContacts() const;
 
   const robot::RobotDescription& robot() const { return robot_; }
   const robot::CameraRig& rig() const { return rig_; }
@@ -112,12 +126,18 @@ class Simulator {
   const WorldSpec& world_spec() const { return spec_; }
   // Renders the cameras now (outside the camera schedule), e.g. for tests and benchmarks.
   RingCapture CaptureRing(bool with_ground_truth);
-  class World& world();
+  // Wall-clock seconds spent rendering ring frames, and how many, since the start.
+  double render_seconds() const;
+  long rendered_frames() const;
+  // The MuJoCo world, for tests that compare it with the URDF (include trimbot/sim/world.h).
+  World& world();
 
  private:
   const garden::SlipModel* SurfaceUnder(int wheel_geom) const;
   // Applies the faults due at the current time; returns whether the cameras deliver images.
   bool ApplyFaults();
+  std::vector<ObstacleContact> ObstacleContacts() const;
+  void ReadSensors(double stamp_before, SensorOutputs* sensors);
 
   SimulatorConfig config_;
   robot::RobotDescription robot_;

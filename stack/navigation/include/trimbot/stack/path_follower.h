@@ -50,6 +50,8 @@ class PathFollower {
 
   // Index of the first sharp vertex after `segment` (or of the goal).
   std::size_t StretchEnd(std::size_t segment) const;
+  // The pure-pursuit target: `lookahead` along the path from `fraction` of the progress segment.
+  Eigen::Vector2d LookaheadPoint(double fraction, std::size_t stretch_end) const;
 };
 
 }  // namespace trimbot::stack

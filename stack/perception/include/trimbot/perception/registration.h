@@ -61,8 +61,5 @@ class RegistrationError : public std::invalid_argument {
 RegistrationResult Register(const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
                             const RegistrationOptions& options = {});
 
-// Geodesic rotation error in degrees and translation error in metres of `estimate` against `truth`.
-double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
-double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
 
 }  // namespace trimbot::perception

@@ -1,0 +1,40 @@
+#include "cli/batch_command.h"
+
+#include <memory>
+
+#include "runner/batch.h"
+
+namespace trimbot::scenarios {
+
+void AddBatchCommands(CLI::App& app, const std::string& data_root, int& exit_code) {
+  auto options = std::make_shared<BatchOptions>();
+  auto trials = std::make_shared<int>(0);
+  auto seed = std::make_shared<std::uint64_t>(0);
+  auto shard = std::make_shared<std::string>("0/1");
+
+  auto* run = app.add_subcommand("run", "run a scenario's navigation trials headless and report against its criteria");
+  run->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
+  run->add_option("--out", options->out_dir, "output folder")->required();
+  auto* trials_option = run->add_option("--trials", *trials, "number of trials (default: the scenario's)")
+                            ->check(CLI::PositiveNumber);
+  auto* seed_option = run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
+  run->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
+  run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
+  run->callback([options, trials, seed, shard, trials_option, seed_option, &data_root, &exit_code]() {
+    options->paths = {data_root};
+    if (trials_option->count() > 0) options->trials = *trials;
+    if (seed_option->count() > 0) options->seed = *seed;
+    std::tie(options->shard_index, options->shard_count) = ParseShard(*shard, "--shard");
+    exit_code = RunBatch(*options);
+  });
+
+  auto shard_dirs = std::make_shared<std::vector<std::string>>();
+  auto merged_out = std::make_shared<std::string>();
+  auto* merge = app.add_subcommand("merge", "merge the output folders of a batch's shards and report on the whole batch");
+  merge->add_option("shards", *shard_dirs, "output folders of `trimbot run --shard`")->required();
+  merge->add_option("--out", *merged_out, "output folder of the merged batch")->required();
+  merge->callback([shard_dirs, merged_out, &data_root, &exit_code]() { exit_code = MergeShards(*shard_dirs, *merged_out, ProjectPaths{data_root}); });
+}
+
+}  // namespace trimbot::scenarios

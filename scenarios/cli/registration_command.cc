@@ -1,0 +1,156 @@
+#include "cli/registration_command.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "eval/pose_errors.h"
+#include "eval/trial_result.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/perception/registration.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+namespace fs = std::filesystem;
+
+double Median(const std::vector<double>& v) { return ErrorStats::From(v).median; }
+
+}  // namespace
+
+RegistrationPair LoadRegistrationPair(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open the pair file");
+  RegistrationPair pair;
+  pair.name = fs::path(path).stem().string();
+  bool have_r = false, have_t = false;
+  std::string line;
+  int number = 0;
+  perception::PointCloud* block = nullptr;
+  long remaining = 0;
+  auto fail = [&](const std::string& problem) -> void {
+    throw InputError(path, "line " + std::to_string(number) + ": " + problem);
+  };
+  while (std::getline(in, line)) {
+    ++number;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream fields(line);
+    std::string head;
+    if (!(fields >> head)) continue;
+    if (remaining > 0) {
+      double v[9];
+      std::istringstream values(line);
+      for (double& value : v) {
+        std::string token;
+        if (!(values >> token)) fail("expected 9 numbers (x y z c00 c01 c02 c11 c12 c22)");
+        try {
+          value = std::stod(token);  // "nan" is accepted here; unusable points are dropped later
+        } catch (const std::exception&) {
+          fail("'" + token + "' is not a number");
+        }
+      }
+      Eigen::Matrix3d c;
+      c << v[3], v[4], v[5], v[4], v[6], v[7], v[5], v[7], v[8];
+      block->Add({v[0], v[1], v[2]}, c);
+      --remaining;
+      continue;
+    }
+    if (head == "R" || head == "t") {
+      const int n = head == "R" ? 9 : 3;
+      double v[9];
+      for (int i = 0; i < n; ++i) {
+        if (!(fields >> v[i])) fail("'" + head + "' needs " + std::to_string(n) + " numbers");
+      }
+      if (head == "R") {
+        pair.truth.linear() << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+        have_r = true;
+      } else {
+        pair.truth.translation() << v[0], v[1], v[2];
+        have_t = true;
+      }
+    } else if (head == "X" || head == "Y") {
+      if (!(fields >> remaining) || remaining < 0) fail("'" + head + "' needs a point count");
+      block = head == "X" ? &pair.x : &pair.y;
+    } else {
+      fail("unexpected '" + head + "' (expected R, t, X or Y)");
+    }
+  }
+  if (remaining > 0) throw InputError(path, "ends " + std::to_string(remaining) + " points early");
+  if (!have_r || !have_t) throw InputError(path, "has no ground truth (lines R and t)");
+  if (pair.x.empty() || pair.y.empty()) throw InputError(path, "needs both an X and a Y block");
+  return pair;
+}
+
+void AddRegistrationCommand(CLI::App& app, int& exit_code) {
+  struct Options {
+    std::string folder;
+    std::string method = "dugma";
+    std::vector<std::string> exclude;
+    perception::RegistrationOptions registration;
+  };
+  auto options = std::make_shared<Options>();
+  auto* command = app.add_subcommand(
+      "register", "register point-cloud pairs (DUGMA data set format) and report errors against ground truth");
+  command->add_option("folder", options->folder, "folder of pair_NN.txt files")->required();
+  command->add_option("--method", options->method, "dugma or icp")->check(CLI::IsMember({"dugma", "icp"}));
+  command->add_option("--exclude", options->exclude, "pair names to leave out (e.g. pair_26)");
+  auto& r = options->registration;
+  command->add_option("--iterations", r.max_iterations, "most EM / ICP iterations")->check(CLI::PositiveNumber);
+  command->add_option("--neighbours", r.neighbours, "target points per source point (DUGMA)")->check(CLI::Range(1, 64));
+  command->add_option("--anneal-start", r.anneal_start, "initial spread in m (<0: from the misalignment)");
+  command->add_option("--anneal-factor", r.anneal_factor, "spread factor per iteration")->check(CLI::Range(0.1, 0.99));
+  command->add_option("--outlier-weight", r.outlier_weight, "weight of the outlier term")->check(CLI::NonNegativeNumber);
+  command->callback([options, &exit_code]() {
+    if (!fs::is_directory(options->folder)) throw InputError(options->folder, "not a folder");
+    std::vector<std::string> files;
+    for (const auto& entry : fs::directory_iterator(options->folder)) {
+      if (entry.path().extension() == ".txt") files.push_back(entry.path().string());
+    }
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw InputError(options->folder, "holds no .txt pair files");
+
+    perception::RegistrationOptions registration = options->registration;
+    registration.method = options->method == "icp" ? perception::RegistrationMethod::kIcp
+                                                    : perception::RegistrationMethod::kDugma;
+    registration.relative_covariances = true;  // the data set's covariances are relative weights
+    registration.max_variance = 1e5;           // its 1e6 entries mark unusable points
+
+    std::cout << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
+              << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)"
+              << std::setw(7) << "iters" << std::setw(10) << "time (s)" << "\n";
+    std::vector<double> rotation, translation, seconds;
+    int under_5_degrees = 0;
+    for (const auto& file : files) {
+      const RegistrationPair pair = LoadRegistrationPair(file);
+      if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) != options->exclude.end()) continue;
+      const auto start = std::chrono::steady_clock::now();
+      const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), registration);
+      const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double r = RotationErrorDegrees(result.transform, pair.truth);
+      const double t = TranslationError(result.transform, pair.truth);
+      rotation.push_back(r);
+      translation.push_back(t);
+      seconds.push_back(time);
+      under_5_degrees += r < 5.0 ? 1 : 0;
+      const int dropped = static_cast<int>(pair.x.size() + pair.y.size()) - result.target_points.kept -
+                          result.source_points.kept;
+      std::cout << std::left << std::setw(10) << pair.name << std::right << std::setw(8) << pair.x.size()
+                << std::setw(8) << pair.y.size() << std::setw(9) << dropped << std::fixed << std::setprecision(2)
+                << std::setw(11) << r << std::setprecision(3) << std::setw(11) << t << std::setw(7)
+                << result.iterations << std::setprecision(3) << std::setw(10) << time << "\n";
+    }
+    std::cout << std::fixed << std::setprecision(3) << "median (" << options->method << ", " << rotation.size()
+              << " pairs): rotation " << Median(rotation) << " deg, translation " << Median(translation)
+              << " m, time " << Median(seconds) << " s; " << under_5_degrees << " of " << rotation.size()
+              << " under 5 deg\n";
+    exit_code = 0;
+  });
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,146 @@
+#include "eval/trial_evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "eval/pose_errors.h"
+#include "reports/output_files.h"
+#include "trimbot/common/atomic_file.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+constexpr double kEvaluationPeriod = 0.1;  // s: estimate errors and trajectories at 10 Hz
+
+void AddError(EstimateErrors& errors, double truth_x, double truth_y, double truth_yaw, const stack::Pose2& pose) {
+  errors.position_m.push_back(std::hypot(pose.x - truth_x, pose.y - truth_y));
+  errors.heading_deg.push_back(std::abs(AngleDifference(pose.yaw, truth_yaw)) * 180.0 / M_PI);
+}
+
+std::string Tum(double t, const stack::Pose2& pose) { return TumLine(t, stack::ToIsometry(pose)); }
+
+}  // namespace
+
+TrialEvaluator::TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance,
+                               double fix_history_seconds)
+    : goal_tolerance_(goal_tolerance), fix_history_seconds_(fix_history_seconds), goal_planned_(goals.size(), false) {
+  for (const auto& goal : goals) goals_.push_back({goal.x(), goal.y()});
+}
+
+TrialEvaluator::PlanarPose TrialEvaluator::Planar(double t, const Eigen::Isometry3d& pose) {
+  const stack::Pose2 planar = stack::ToPose2(pose);
+  return {t, planar.x, planar.y, planar.yaw};
+}
+
+const TrialEvaluator::PlanarPose* TrialEvaluator::TruthAt(double stamp) const {
+  const PlanarPose* best = nullptr;
+  for (const auto& p : truth_history_) {
+    if (best == nullptr || std::abs(p.t - stamp) < std::abs(best->t - stamp)) best = &p;
+  }
+  return best != nullptr && std::abs(best->t - stamp) <= timestep_ ? best : nullptr;
+}
+
+void TrialEvaluator::Observe(const StepView& step) {
+  ++steps_;
+  timestep_ = step.timestep;
+  const PlanarPose truth = Planar(step.time, step.truth.T_map_base);
+  truth_history_.push_back(truth);
+  while (truth_history_.size() > 2 && truth_history_.front().t < truth.t - fix_history_seconds_) {
+    truth_history_.pop_front();
+  }
+  for (const auto& fix : step.pose_fixes) {
+    fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
+    if (const PlanarPose* at = TruthAt(fix.stamp)) AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
+  }
+  if (have_previous_) path_length_ += std::hypot(truth.x - previous_.x, truth.y - previous_.y);
+  previous_ = truth;
+  have_previous_ = true;
+  ObserveContacts(step);
+  if (step.telemetry == nullptr) return;
+  if (steps_ % std::lround(kEvaluationPeriod / step.timestep) == 0) Sample(step, truth);
+  ObserveEvents(step, truth);
+}
+
+void TrialEvaluator::ObserveContacts(const StepView& step) {
+  const bool contact = !step.truth.contacts.empty();
+  if (contact && !in_contact_) {
+    ++collisions_;
+    const int goal = step.telemetry ? step.telemetry->current_goal : 0;
+    events_csv_ += std::to_string(step.time) + ",collision," + std::to_string(goal) + "," +
+                   step.truth.contacts.front().object_geom + "\n";
+  }
+  if (contact) contact_seconds_ += step.timestep;
+  in_contact_ = contact;
+}
+
+void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
+  const stack::Pose2& estimate = step.telemetry->estimate.pose;
+  const stack::Pose2& odometry = step.telemetry->odometry;
+  AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
+  AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);
+  truth_tum_ += Tum(truth.t, {truth.x, truth.y, truth.yaw});
+  ekf_tum_ += Tum(step.time, estimate);
+  odometry_tum_ += Tum(step.time, odometry);
+}
+
+void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth) {
+  using Type = stack::NavigationEvent::Type;
+  for (const auto& event : step.telemetry->events) {
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(3) << event.stamp << ',' << stack::ToString(event.type) << ','
+         << event.goal << ',' << event.detail << '\n';
+    events_csv_ += line.str();
+    if (event.type == Type::kPlanned) {
+      ++plans_;
+      if (event.goal >= 0 && event.goal < static_cast<int>(goal_planned_.size())) goal_planned_[event.goal] = true;
+    }
+    if (event.type == Type::kRecovered) ++recoveries_;
+    if (event.type == Type::kGoalReached && event.goal >= 0 && event.goal < static_cast<int>(goals_.size())) {
+      GoalResult& goal = goals_[event.goal];
+      goal.arrival_time = step.time;
+      goal.final_error_m = std::hypot(truth.x - goal.x, truth.y - goal.y);
+      goal.reached = goal.final_error_m <= goal_tolerance_;
+    }
+  }
+}
+
+void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telemetry& telemetry, TrialResult* result) {
+  result->goals = goals_;
+  if (!finished) {
+    result->status = "timeout";
+    result->message = "time limit of " + std::to_string(time_limit) + " s reached";
+  } else if (telemetry.mission == stack::MissionState::kFailed) {
+    result->status = "failed";
+    result->message = "navigation gave up goal " + std::to_string(telemetry.current_goal);
+  } else {
+    result->status = "completed";
+  }
+  // One plan per goal that got a plan is expected; the others were replans.
+  result->replans = plans_ - static_cast<int>(std::count(goal_planned_.begin(), goal_planned_.end(), true));
+  result->recoveries = recoveries_;
+  result->path_length_m = path_length_;
+  result->collisions = collisions_;
+  result->contact_seconds = contact_seconds_;
+  result->simulated_seconds = telemetry.stamp;
+  result->fixes_accepted = telemetry.localization.fixes_accepted;
+  result->fixes_rejected = telemetry.localization.fixes_rejected;
+  result->relocalizations = telemetry.localization.relocalizations;
+  result->estimates = {ekf_, odometry_, fixes_};
+  const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
+  result->success = result->status == "completed" && all_reached && collisions_ == 0;
+  if (result->status == "completed" && !result->success) {
+    result->message = !all_reached ? "a goal was declared reached outside the tolerance" : "collided with the garden";
+  }
+}
+
+void TrialEvaluator::WriteFiles(const std::string& dir) const {
+  WriteFileAtomically(dir + "/ground_truth.tum", truth_tum_);
+  WriteFileAtomically(dir + "/ekf.tum", ekf_tum_);
+  WriteFileAtomically(dir + "/wheel_odometry.tum", odometry_tum_);
+  WriteFileAtomically(dir + "/pose_fixes.tum", fixes_tum_);
+  WriteFileAtomically(dir + "/events.csv", events_csv_);
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,59 @@
+#pragma once
+// Evaluation of a navigation trial against the ground truth, as an observer of the closed loop:
+// estimate errors (EKF, wheel odometry, pose fixes at their own stamps), path length, collisions
+// (contacts with garden objects), goals reached (judged on the ground truth when the stack says it
+// arrived), replans and recoveries from the stack's events. Writes ground_truth.tum, ekf.tum,
+// wheel_odometry.tum, pose_fixes.tum (TUM, usable with evo) and events.csv.
+#include <Eigen/Core>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "eval/trial_result.h"
+#include "runner/closed_loop.h"
+
+namespace trimbot::scenarios {
+
+class TrialEvaluator : public Observer {
+ public:
+  // `fix_history_seconds`: how late a pose fix may arrive and still be judged at its stamp.
+  TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance, double fix_history_seconds);
+
+  void Observe(const StepView& step) override;
+
+  // Completes `result` (status, goals, counts, errors) from what was observed; `finished`: the
+  // stack ended its mission before the time limit.
+  void Finish(bool finished, double time_limit, const stack::Telemetry& final_telemetry, TrialResult* result);
+  // Writes the trajectories and events into `dir`.
+  void WriteFiles(const std::string& dir) const;
+
+ private:
+  struct PlanarPose {
+    double t = 0.0, x = 0.0, y = 0.0, yaw = 0.0;
+  };
+  static PlanarPose Planar(double t, const Eigen::Isometry3d& pose);
+  const PlanarPose* TruthAt(double stamp) const;
+  void ObserveEvents(const StepView& step, const PlanarPose& truth);
+  void ObserveContacts(const StepView& step);
+  void Sample(const StepView& step, const PlanarPose& truth);
+
+  double goal_tolerance_;
+  double fix_history_seconds_;
+  std::vector<GoalResult> goals_;
+  EstimateErrors ekf_{"ekf", {}, {}}, odometry_{"wheel_odometry", {}, {}}, fixes_{"pose_fixes", {}, {}};
+  std::string truth_tum_, ekf_tum_, odometry_tum_, fixes_tum_;
+  std::string events_csv_ = "t,event,goal,detail\n";
+  std::deque<PlanarPose> truth_history_;    // the last seconds, to judge late fixes at their stamps
+  bool have_previous_ = false;
+  PlanarPose previous_;
+  double path_length_ = 0.0;
+  bool in_contact_ = false;
+  int collisions_ = 0;
+  double contact_seconds_ = 0.0;
+  int plans_ = 0, recoveries_ = 0;
+  std::vector<bool> goal_planned_;
+  long steps_ = 0;
+  double timestep_ = 0.0;
+};
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,175 @@
+#include "eval/trial_result.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace trimbot::scenarios {
+
+ErrorStats ErrorStats::From(std::vector<double> samples) {
+  ErrorStats stats;
+  if (samples.empty()) return stats;
+  stats.count = static_cast<int>(samples.size());
+  std::sort(samples.begin(), samples.end());
+  double sum = 0.0, sum_of_squares = 0.0;
+  for (const double s : samples) {
+    sum += s;
+    sum_of_squares += s * s;
+  }
+  const std::size_t n = samples.size();
+  stats.mean = sum / n;
+  stats.median = n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+  stats.rmse = std::sqrt(sum_of_squares / n);
+  stats.max = samples.back();
+  return stats;
+}
+
+void to_json(nlohmann::json& j, const ErrorStats& s) {
+  j = {{"count", s.count}, {"mean", s.mean}, {"median", s.median}, {"rmse", s.rmse}, {"max", s.max}};
+}
+
+void to_json(nlohmann::json& j, const EstimateErrors& e) {
+  // The summaries are for people and scripts reading the file; only the samples are read back.
+  j = {{"name", e.name},
+       {"position_m", e.position_m},
+       {"heading_deg", e.heading_deg},
+       {"position_stats_m", e.position()},
+       {"heading_stats_deg", e.heading()}};
+}
+
+void from_json(const nlohmann::json& j, EstimateErrors& e) {
+  j.at("name").get_to(e.name);
+  j.at("position_m").get_to(e.position_m);
+  j.at("heading_deg").get_to(e.heading_deg);
+}
+
+void to_json(nlohmann::json& j, const GoalResult& g) {
+  j = {{"x", g.x},
+       {"y", g.y},
+       {"reached", g.reached},
+       {"arrival_time", g.arrival_time},
+       {"final_error_m", g.final_error_m}};
+}
+
+void from_json(const nlohmann::json& j, GoalResult& g) {
+  j.at("x").get_to(g.x);
+  j.at("y").get_to(g.y);
+  j.at("reached").get_to(g.reached);
+  j.at("arrival_time").get_to(g.arrival_time);
+  j.at("final_error_m").get_to(g.final_error_m);
+}
+
+void to_json(nlohmann::json& j, const TrialResult& t) {
+  j = {{"index", t.index},
+       {"seed", t.seed},
+       {"status", t.status},
+       {"message", t.message},
+       {"success", t.success},
+       {"goals", t.goals},
+       {"simulated_seconds", t.simulated_seconds},
+       {"path_length_m", t.path_length_m},
+       {"collisions", t.collisions},
+       {"contact_seconds", t.contact_seconds},
+       {"replans", t.replans},
+       {"recoveries", t.recoveries},
+       {"fixes_accepted", t.fixes_accepted},
+       {"fixes_rejected", t.fixes_rejected},
+       {"relocalizations", t.relocalizations},
+       {"faults", t.faults},
+       {"estimates", t.estimates}};
+}
+
+void from_json(const nlohmann::json& j, TrialResult& t) {
+  j.at("index").get_to(t.index);
+  j.at("seed").get_to(t.seed);
+  j.at("status").get_to(t.status);
+  j.at("message").get_to(t.message);
+  j.at("success").get_to(t.success);
+  j.at("goals").get_to(t.goals);
+  j.at("simulated_seconds").get_to(t.simulated_seconds);
+  j.at("path_length_m").get_to(t.path_length_m);
+  j.at("collisions").get_to(t.collisions);
+  j.at("contact_seconds").get_to(t.contact_seconds);
+  j.at("replans").get_to(t.replans);
+  j.at("recoveries").get_to(t.recoveries);
+  j.at("fixes_accepted").get_to(t.fixes_accepted);
+  j.at("fixes_rejected").get_to(t.fixes_rejected);
+  j.at("relocalizations").get_to(t.relocalizations);
+  j.at("faults").get_to(t.faults);
+  j.at("estimates").get_to(t.estimates);
+}
+
+void to_json(nlohmann::json& j, const CriterionResult& c) {
+  j = {{"name", c.name},
+       {"comparison", c.comparison},
+       {"expected", c.expected},
+       {"actual", c.actual},
+       {"pass", c.pass}};
+}
+
+void to_json(nlohmann::json& j, const BatchSummary& b) {
+  j = {{"scenario", b.scenario},
+       {"scenario_file", b.scenario_file},
+       {"seed", b.seed},
+       {"trials_planned", b.trials_planned},
+       {"pass", b.pass},
+       {"criteria", b.criteria},
+       {"metrics", b.metrics},
+       {"trials", b.trials}};
+}
+
+nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned) {
+  // Trials that never ran are missing from `trials` but still count in the rates' denominators.
+  const int planned = std::max<int>(trials_planned, static_cast<int>(trials.size()));
+  int successes = 0, completed = 0, collisions = 0, recoveries = 0, goals_reached = 0;
+  int goals_per_trial = 0;
+  double simulated_seconds = 0.0, path_length_m = 0.0;
+  std::vector<std::string> estimate_names;  // in order of first appearance
+  std::map<std::string, std::vector<double>> pooled_position_m, pooled_heading_deg;
+  for (const TrialResult& trial : trials) {
+    successes += trial.success ? 1 : 0;
+    completed += trial.status == "completed" ? 1 : 0;
+    collisions += trial.collisions;
+    recoveries += trial.recoveries;
+    if (!trial.goals.empty()) goals_per_trial = static_cast<int>(trial.goals.size());
+    goals_reached += static_cast<int>(
+        std::count_if(trial.goals.begin(), trial.goals.end(), [](const GoalResult& g) { return g.reached; }));
+    simulated_seconds += trial.simulated_seconds;
+    path_length_m += trial.path_length_m;
+    for (const EstimateErrors& estimate : trial.estimates) {
+      if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
+      auto& position = pooled_position_m[estimate.name];
+      auto& heading = pooled_heading_deg[estimate.name];
+      position.insert(position.end(), estimate.position_m.begin(), estimate.position_m.end());
+      heading.insert(heading.end(), estimate.heading_deg.begin(), estimate.heading_deg.end());
+    }
+  }
+
+  const auto ratio = [](double numerator, double denominator) { return denominator > 0 ? numerator / denominator : 0.0; };
+  const double ran = static_cast<double>(trials.size());
+  nlohmann::json metrics = nlohmann::json::object();
+  metrics["success_rate"] = ratio(successes, planned);
+  metrics["goal_success_rate"] = ratio(goals_reached, static_cast<double>(goals_per_trial) * planned);
+  metrics["trials_completed"] = completed;
+  metrics["collisions"] = collisions;
+  metrics["recoveries"] = recoveries;
+  metrics["mean_trial_seconds"] = ratio(simulated_seconds, ran);
+  metrics["mean_path_length_m"] = ratio(path_length_m, ran);
+  for (const std::string& name : estimate_names) {
+    // An estimate without samples (e.g. no pose fix arrived) has no error metrics, so a criterion
+    // on it fails as "not measured" instead of passing with 0.
+    if (pooled_position_m[name].empty()) continue;
+    const ErrorStats position = ErrorStats::From(pooled_position_m[name]);
+    const ErrorStats heading = ErrorStats::From(pooled_heading_deg[name]);
+    metrics[name + "_position_error_mean_m"] = position.mean;
+    metrics[name + "_position_error_median_m"] = position.median;
+    metrics[name + "_position_error_max_m"] = position.max;
+    metrics[name + "_position_error_rmse_m"] = position.rmse;
+    metrics[name + "_heading_error_mean_deg"] = heading.mean;
+    metrics[name + "_heading_error_median_deg"] = heading.median;
+    metrics[name + "_heading_error_max_deg"] = heading.max;
+  }
+  return metrics;
+}
+
+}  // namespace trimbot::scenarios

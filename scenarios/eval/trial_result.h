@@ -1,0 +1,93 @@
+#pragma once
+// Plain data between the stages of a batch: each trial ends in a TrialResult (written as
+// trials/NNN/result.json by the process that ran it); a batch (one run, or shards merged) turns
+// the trial results into a BatchSummary with the scenario's pass criteria evaluated.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace trimbot::scenarios {
+
+// Statistics of a set of error samples (all zero with count 0 when there are none).
+struct ErrorStats {
+  int count = 0;
+  double mean = 0.0, median = 0.0, rmse = 0.0, max = 0.0;
+  static ErrorStats From(std::vector<double> samples);
+};
+
+// Error of one pose estimate (ekf, wheel_odometry, pose_fixes) against ground truth, sampled at
+// the estimate's own stamps (fixes) or at the evaluation rate (filters).
+struct EstimateErrors {
+  std::string name;
+  std::vector<double> position_m;    // samples, metres
+  std::vector<double> heading_deg;   // samples, degrees (absolute)
+  ErrorStats position() const { return ErrorStats::From(position_m); }
+  ErrorStats heading() const { return ErrorStats::From(heading_deg); }
+};
+
+struct GoalResult {
+  double x = 0.0, y = 0.0;        // goal in the map frame
+  bool reached = false;           // the robot declared arrival and was within tolerance (ground truth)
+  double arrival_time = -1.0;     // s of simulated time since the trial's start, -1 if never
+  double final_error_m = -1.0;    // ground-truth distance to the goal when the robot declared arrival
+};
+
+struct TrialResult {
+  int index = 0;
+  std::uint64_t seed = 0;
+  std::string status = "not run";  // completed | failed | timeout | crashed | error
+  std::string message;             // why a trial did not complete
+  bool success = false;            // every goal reached, no collision
+  std::vector<GoalResult> goals;
+  double simulated_seconds = 0.0;
+  double wall_seconds = 0.0;       // not in result.json / summary.json (see timing.json): not reproducible
+  double path_length_m = 0.0;      // ground truth
+  int collisions = 0;              // separate contact events with garden objects
+  double contact_seconds = 0.0;
+  int replans = 0;
+  int recoveries = 0;              // obstacle stops followed by a recovery manoeuvre
+  int fixes_accepted = 0, fixes_rejected = 0, relocalizations = 0;
+  std::vector<std::string> faults;  // what was injected, in words
+  std::vector<EstimateErrors> estimates;
+};
+
+// One pass criterion of the scenario, e.g. success_rate >= 1.0.
+struct CriterionResult {
+  std::string name;        // metric name as in the scenario file
+  std::string comparison;  // ">=" or "<="
+  double expected = 0.0;
+  double actual = 0.0;
+  bool pass = false;
+};
+
+struct BatchSummary {
+  std::string scenario;        // scenario name
+  std::string scenario_file;
+  std::uint64_t seed = 0;      // batch seed; trial seeds are in the trials
+  int trials_planned = 0;
+  std::vector<TrialResult> trials;
+  // Aggregates over all trials (samples pooled over trials).
+  nlohmann::json metrics;      // name -> number; see ComputeBatchMetrics
+  std::vector<CriterionResult> criteria;
+  bool pass = false;
+};
+
+void to_json(nlohmann::json& j, const ErrorStats& s);
+void to_json(nlohmann::json& j, const EstimateErrors& e);
+void from_json(const nlohmann::json& j, EstimateErrors& e);
+void to_json(nlohmann::json& j, const GoalResult& g);
+void from_json(const nlohmann::json& j, GoalResult& g);
+void to_json(nlohmann::json& j, const TrialResult& t);
+void from_json(const nlohmann::json& j, TrialResult& t);
+void to_json(nlohmann::json& j, const CriterionResult& c);
+void to_json(nlohmann::json& j, const BatchSummary& b);
+
+// Batch metrics from the trials: success_rate (trials with success / trials planned; a trial that
+// never ran counts as failed), goal_success_rate, trials_completed, collisions, recoveries,
+// mean_trial_seconds (simulated), mean_path_length_m, and per estimate E
+// (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
+// E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples).
+nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);
+
+}  // namespace trimbot::scenarios

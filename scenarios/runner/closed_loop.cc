@@ -1,0 +1,41 @@
+#include "runner/closed_loop.h"
+
+#include "eval/simulated_pose_fixes.h"
+
+namespace trimbot::scenarios {
+
+bool RunClosedLoop(sim::Simulator& simulator, Controller& controller, const std::vector<Observer*>& observers,
+                   const LoopOptions& options) {
+  sim::SensorOutputs sensors;
+  sim::GroundTruth truth;
+  std::vector<messages::PoseFix> fixes;
+  // The controller's commands for the first step, from no measurements yet.
+  simulator.Apply(controller.Step(simulator.time(), sensors, fixes));
+  double next_progress = 1.0;
+  while (simulator.time() < options.time_limit - 1e-9) {
+    sensors.Clear();
+    fixes.clear();
+    simulator.Step(&sensors, &truth);
+    const double t = simulator.time();
+    if (options.render_on_demand && truth.ring_exposed && controller.WantsRingFrame(t)) {
+      sim::RingCapture capture = simulator.CaptureRing(false);
+      sensors.ring = std::move(capture.frame);
+      truth.ring = std::move(capture.truth);
+    }
+    if (options.pose_fixes != nullptr) options.pose_fixes->Step(truth, &fixes);
+
+    const messages::RobotCommands commands = controller.Step(t, sensors, fixes);
+    simulator.Apply(commands);
+    const StepView view{t, simulator.timestep(), sensors, fixes, truth, commands, controller.telemetry()};
+    for (Observer* observer : observers) observer->Observe(view);
+
+    if (controller.Finished()) return true;
+    if (options.progress && t >= next_progress) {
+      options.progress(t);
+      next_progress += 1.0;
+    }
+  }
+  return false;
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,50 @@
+#include "runner/drive_plan.h"
+
+#include <cmath>
+
+#include "trimbot/common/yaml_reader.h"
+
+namespace trimbot::scenarios {
+
+double DrivePlan::duration() const {
+  double total = 0.0;
+  for (const auto& segment : segments) total += segment.duration;
+  return total;
+}
+
+const DriveSegment& DrivePlan::SegmentAt(double t) const {
+  double end = 0.0;
+  for (const auto& segment : segments) {
+    end += segment.duration;
+    if (t < end) return segment;
+  }
+  return segments.back();
+}
+
+DrivePlan DrivePlan::Load(const std::string& path) {
+  const YamlMap root = YamlMap::LoadFile(path);
+  DrivePlan plan;
+  plan.source = path;
+  plan.world = WorldSetup::Read(root, /*with_seed=*/true);
+  plan.save_every_frames = root.Int("save_every_frames", 10);
+  if (plan.save_every_frames < 1) root.Fail("save_every_frames", "must be at least 1");
+  for (const YamlMap& item : root.MapList("segments")) {
+    DriveSegment segment;
+    segment.duration = item.Double("duration");
+    if (!(segment.duration > 0.0)) item.Fail("duration", "must be positive");
+    segment.linear = item.Double("linear");
+    segment.angular = item.Double("angular");
+    if (item.Has("arm")) {
+      const auto q = item.Doubles("arm", 6);
+      segment.arm = std::array<double, 6>{q[0], q[1], q[2], q[3], q[4], q[5]};
+    }
+    segment.cutter = item.Bool("cutter", false);
+    item.RejectUnknownKeys();
+    plan.segments.push_back(segment);
+  }
+  if (plan.segments.empty()) root.Fail("segments", "needs at least one segment");
+  root.RejectUnknownKeys();
+  return plan;
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,104 @@
+#include "runner/prior_knowledge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
+#include "trimbot/garden/conditions.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
+
+namespace trimbot::scenarios {
+
+garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
+  garden::Garden surveyed = built;
+  for (int id : survey.unmapped) {
+    const auto it = std::find_if(surveyed.objects.begin(), surveyed.objects.end(),
+                                 [id](const garden::GardenObject& o) { return o.id == id; });
+    if (it == surveyed.objects.end()) {
+      throw InputError(scenario_file, "survey.unmapped: garden '" + built.name + "' has no object " + std::to_string(id));
+    }
+    surveyed.objects.erase(it);
+  }
+  // Foliage grown at survey time: its outline pushed out by the growth on every side.
+  for (auto& object : surveyed.objects) {
+    if (garden::IsFoliage(object.object_class)) {
+      object.size.head<2>() += Eigen::Vector2d::Constant(2.0 * survey.growth * garden::kMaxGrowth);
+    }
+  }
+  surveyed.objects.insert(surveyed.objects.end(), survey.gone.begin(), survey.gone.end());
+  return surveyed;
+}
+
+garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& paths) {
+  const garden::Garden built = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden surveyed = SurveyedGarden(built, scenario.survey, scenario.source);
+  return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, scenario.map_clearance_height);
+}
+
+std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir) {
+  garden::WriteOccupancyMap(map, dir, "map");
+  return dir + "/map.yaml";
+}
+
+stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
+  Rng rng = MakeRng(seed, "initial_pose");
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double dx = normal(rng), dy = normal(rng), dyaw = normal(rng);
+  const sim::Pose2D& start = scenario.world.start;
+  return {start.x + scenario.initial_position_sigma * dx, start.y + scenario.initial_position_sigma * dy,
+          std::remainder(start.yaw + scenario.initial_yaw_sigma * dyaw, 2.0 * M_PI)};
+}
+
+namespace {
+
+Eigen::Isometry3d SmallMotion(Rng& rng, double rotation_sigma, double translation_sigma) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const Eigen::Vector3d w(normal(rng), normal(rng), normal(rng));
+  const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d rotation = rotation_sigma * w;
+  if (rotation.norm() > 0.0) motion.linear() = Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix();
+  motion.translation() = translation_sigma * t;
+  return motion;
+}
+
+}  // namespace
+
+std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, std::uint64_t seed,
+                             const std::string& dir) {
+  const robot::RobotFiles files = paths.robot_files();
+  const CalibrationError& error = scenario.calibration_error;
+  if (!error.any()) return files.camchain;
+  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
+  const robot::CameraRig truth = robot::CameraRig::LoadKalibr(
+      files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
+  Rng rng = MakeRng(seed, "calibration_error");
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<robot::CameraCalibration> cameras = truth.cameras();
+  for (auto& camera : cameras) {
+    auto& k = camera.intrinsics;
+    const double scale = 1.0 + error.focal_relative * normal(rng);
+    k.fx *= scale;
+    k.fy *= scale;
+    k.cx += error.principal_point_px * normal(rng);
+    k.cy += error.principal_point_px * normal(rng);
+    const Eigen::Isometry3d motion = SmallMotion(rng, error.rotation_deg * M_PI / 180.0, error.translation_m);
+    // cam0's pose on the robot comes from the URDF; the chain to the others is the camchain's.
+    if (camera.index > 0) camera.T_base_camera = camera.T_base_camera * motion;
+  }
+  const std::string path = dir + "/stack_camchain.yaml";
+  WriteFileAtomically(path, robot::CameraRig::FromCameras(cameras, path).ToKalibrYaml());
+  return path;
+}
+
+stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths) {
+  const stack::StackParameters defaults = stack::StackParameters::Load(paths.robot_files().stack_parameters);
+  return scenario.stack ? defaults.Overridden(*scenario.stack) : defaults;
+}
+
+}  // namespace trimbot::scenarios

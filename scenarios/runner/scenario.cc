@@ -1,0 +1,181 @@
+#include "runner/scenario.h"
+
+#include <cmath>
+#include <set>
+
+#include "trimbot/common/yaml_reader.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+Eigen::Vector3d OptionalVector3(const YamlMap& map, const std::string& key) {
+  return map.Has(key) ? map.Vector3(key) : Eigen::Vector3d::Zero();
+}
+
+sim::Fault ReadFault(const YamlMap& item) {
+  sim::Fault fault;
+  const std::string type = item.String("type");
+  if (type == "wheel_slip") {
+    fault.kind = sim::Fault::Kind::kWheelSlip;
+    fault.start = item.Double("start");
+    fault.duration = item.Double("duration");
+    fault.slip_left = item.Double("left", 0.0);
+    fault.slip_right = item.Double("right", 0.0);
+    if (fault.slip_left <= -1.0) item.Fail("left", "slip must be greater than -1");
+    if (fault.slip_right <= -1.0) item.Fail("right", "slip must be greater than -1");
+  } else if (type == "imu_bias_jump") {
+    fault.kind = sim::Fault::Kind::kImuBiasJump;
+    fault.start = item.Double("time");
+    fault.gyroscope_bias_jump = OptionalVector3(item, "gyro");
+    fault.accelerometer_bias_jump = OptionalVector3(item, "accel");
+  } else if (type == "camera_dropout") {
+    fault.kind = sim::Fault::Kind::kCameraDropout;
+    fault.start = item.Double("start");
+    fault.duration = item.Double("duration");
+  } else {
+    item.Fail("type", "unknown fault '" + type + "' (wheel_slip, imu_bias_jump, camera_dropout)");
+  }
+  if (fault.start < 0.0) item.Fail(type == "imu_bias_jump" ? "time" : "start", "must not be negative");
+  if (fault.kind != sim::Fault::Kind::kImuBiasJump && !(fault.duration > 0.0)) item.Fail("duration", "must be positive");
+  item.RejectUnknownKeys();
+  return fault;
+}
+
+SimulatedPoseFixParameters ReadSimulatedPoseFixes(const YamlMap& map) {
+  SimulatedPoseFixParameters p;
+  p.availability = map.NumberOr("availability", p.availability, 0.0, 1.0);
+  p.position_sigma = map.NumberOr("position_sigma", p.position_sigma, 0.0, 100.0, "m");
+  p.yaw_sigma = map.NumberOr("yaw_sigma_deg", p.yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
+  p.latency_median = map.NumberOr("latency_median", p.latency_median, 1e-3, 60.0, "s");
+  p.latency_log_sigma = map.NumberOr("latency_log_sigma", p.latency_log_sigma, 0.0, 10.0);
+  p.latency_max = map.NumberOr("latency_max", p.latency_max, 1e-3, 60.0, "s");
+  p.outlier_probability = map.NumberOr("outlier_probability", p.outlier_probability, 0.0, 1.0);
+  p.outlier_min = map.NumberOr("outlier_min", p.outlier_min, 0.0, 1000.0, "m");
+  p.outlier_max = map.NumberOr("outlier_max", p.outlier_max, 0.0, 1000.0, "m");
+  map.RejectUnknownKeys();
+  if (p.latency_max < p.latency_median) map.Fail("latency_max", "must be at least latency_median");
+  if (p.outlier_max < p.outlier_min) map.Fail("outlier_max", "must be at least outlier_min");
+  return p;
+}
+
+Survey ReadSurvey(const YamlMap& map) {
+  Survey survey;
+  survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
+  if (map.Has("unmapped")) {
+    for (double id : map.Doubles("unmapped")) {
+      if (id != std::floor(id) || id < 1) map.Fail("unmapped", "object ids are positive whole numbers");
+      survey.unmapped.push_back(static_cast<int>(id));
+    }
+  }
+  if (map.Has("gone")) {
+    for (const YamlMap& item : map.MapList("gone")) survey.gone.push_back(garden::ReadGardenObject(item));
+  }
+  map.RejectUnknownKeys();
+  return survey;
+}
+
+CalibrationError ReadCalibrationError(const YamlMap& map) {
+  CalibrationError e;
+  e.focal_relative = map.NumberOr("focal_relative", 0.0, 0.0, 0.5);
+  e.principal_point_px = map.NumberOr("principal_point_px", 0.0, 0.0, 100.0, "px");
+  e.rotation_deg = map.NumberOr("rotation_deg", 0.0, 0.0, 30.0, "deg");
+  e.translation_m = map.NumberOr("translation_m", 0.0, 0.0, 0.5, "m");
+  map.RejectUnknownKeys();
+  return e;
+}
+
+void ReadMission(const YamlMap& root, Scenario& s) {
+  if (root.Has("map")) {
+    const YamlMap map = root.Map("map");
+    s.map_resolution = map.NumberOr("resolution", s.map_resolution, 0.005, 1.0, "m");
+    s.map_clearance_height = map.NumberOr("clearance_height", s.map_clearance_height, 0.0, 10.0, "m");
+    map.RejectUnknownKeys();
+  }
+  if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"));
+  for (const YamlMap& goal : root.MapList("goals")) {
+    s.goals.emplace_back(goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m"));
+    goal.RejectUnknownKeys();
+  }
+  if (s.goals.empty()) root.Fail("goals", "needs at least one goal");
+  s.goal_tolerance = root.NumberOr("goal_tolerance", s.goal_tolerance, 1e-3, 10.0, "m");
+  if (root.Has("initial_pose_sigma")) {
+    const YamlMap sigma = root.Map("initial_pose_sigma");
+    s.initial_position_sigma = sigma.NumberOr("position", s.initial_position_sigma, 0.0, 10.0, "m");
+    s.initial_yaw_sigma = sigma.NumberOr("yaw_deg", s.initial_yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
+    sigma.RejectUnknownKeys();
+  }
+  if (root.Has("calibration_error")) s.calibration_error = ReadCalibrationError(root.Map("calibration_error"));
+}
+
+void ReadPlant(const YamlMap& root, Scenario& s) {
+  if (root.Has("cameras")) {
+    const YamlMap cameras = root.Map("cameras");
+    s.render_cameras = cameras.Bool("render", s.render_cameras);
+    s.resolution_scale = cameras.NumberOr("resolution_scale", s.resolution_scale, 0.05, 1.0);
+    cameras.RejectUnknownKeys();
+  }
+  if (root.Has("noise")) {
+    const YamlMap noise = root.Map("noise");
+    s.imu_noise_scale = noise.NumberOr("imu", 1.0, 0.0, 100.0);
+    s.wheel_slip_scale = noise.NumberOr("wheel_slip", 1.0, 0.0, 100.0);
+    noise.RejectUnknownKeys();
+  }
+  if (root.Has("simulated_pose_fixes")) s.simulated_pose_fixes = ReadSimulatedPoseFixes(root.Map("simulated_pose_fixes"));
+  if (root.Has("faults")) {
+    for (const YamlMap& item : root.MapList("faults")) s.faults.push_back(ReadFault(item));
+  }
+}
+
+void ReadCriteria(const YamlMap& criteria, Scenario& s) {
+  for (const auto& entry : criteria.node()) {
+    if (!entry.first.IsScalar()) criteria.Fail("criteria", "metric names must be plain names");
+    const std::string metric = entry.first.as<std::string>();
+    if (!IsKnownMetric(metric)) criteria.Fail(metric, "unknown metric");
+    const YamlMap bound = criteria.Map(metric);
+    PassCriterion criterion;
+    criterion.metric = metric;
+    if (bound.Has("min") == bound.Has("max")) bound.Fail("min", "give exactly one of min or max");
+    criterion.comparison = bound.Has("min") ? ">=" : "<=";
+    criterion.threshold = bound.Has("min") ? bound.Number("min", -1e12, 1e12) : bound.Number("max", -1e12, 1e12);
+    bound.RejectUnknownKeys();
+    s.criteria.push_back(criterion);
+  }
+  criteria.RejectUnknownKeys();
+}
+
+}  // namespace
+
+bool IsKnownMetric(const std::string& name) {
+  static const std::set<std::string> kMetrics = [] {
+    std::set<std::string> names = {"success_rate", "goal_success_rate", "trials_completed", "collisions",
+                                   "recoveries",   "mean_trial_seconds", "mean_path_length_m"};
+    for (const char* estimate : {"ekf", "wheel_odometry", "pose_fixes"}) {
+      for (const char* stat : {"mean", "median", "max", "rmse"}) {
+        names.insert(std::string(estimate) + "_position_error_" + stat + "_m");
+        if (std::string(stat) != "rmse") names.insert(std::string(estimate) + "_heading_error_" + stat + "_deg");
+      }
+    }
+    return names;
+  }();
+  return kMetrics.count(name) > 0;
+}
+
+Scenario Scenario::Load(const std::string& path) {
+  const YamlMap root = YamlMap::LoadFile(path);
+  Scenario s;
+  s.source = path;
+  s.name = root.String("name");
+  s.description = root.String("description", "");
+  s.world = WorldSetup::Read(root, /*with_seed=*/true);
+  ReadMission(root, s);
+  s.trials = root.Has("trials") ? root.Integer("trials", 1, 100000) : 1;
+  s.time_limit = root.NumberOr("time_limit", s.time_limit, 1e-3, 1e6, "s");
+  s.wall_time_limit = root.NumberOr("wall_time_limit", s.wall_time_limit, 1e-3, 1e7, "s");
+  ReadPlant(root, s);
+  if (root.Has("stack")) s.stack = root.Map("stack");
+  if (root.Has("criteria")) ReadCriteria(root.Map("criteria"), s);
+  root.RejectUnknownKeys();
+  return s;
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,76 @@
+#pragma once
+// A navigation scenario: the world (garden, true start, conditions), the robot's prior knowledge
+// (the map as surveyed, how well it knows its start, the calibration it reads), its mission
+// (goals), the simulated plant's noise and faults, the robot software's settings (`stack:`, over
+// robot/config/stack.yaml), how many trials with which seed, and the pass criteria. Read strictly
+// from YAML (unknown keys, wrong types, non-finite or out-of-range numbers are errors with file,
+// line and key).
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "eval/simulated_pose_fixes.h"
+#include "runner/world_setup.h"
+#include "trimbot/common/yaml_reader.h"
+#include "trimbot/garden/garden.h"
+#include "trimbot/sim/faults.h"
+
+namespace trimbot::scenarios {
+
+struct PassCriterion {
+  std::string metric;       // a batch metric (see ComputeBatchMetrics)
+  std::string comparison;   // ">=" (min) or "<=" (max)
+  double threshold = 0.0;
+};
+
+// How the robot's prior map differs from the garden as it stands in the simulation.
+struct Survey {
+  double growth = 0.0;                    // foliage as it was when surveyed (0..1, as Conditions)
+  std::vector<int> unmapped;              // object ids the survey missed
+  std::vector<garden::GardenObject> gone;  // objects in the map that are no longer in the garden
+};
+
+// Errors of the calibration the stack reads (the simulator renders with the true one). Seeded
+// per trial; each a standard deviation.
+struct CalibrationError {
+  double focal_relative = 0.0;      // fx, fy scaled by (1 + e)
+  double principal_point_px = 0.0;  // cx, cy
+  double rotation_deg = 0.0;        // of each camera relative to cam0 (cam0's pose is the URDF's)
+  double translation_m = 0.0;       // of each camera relative to cam0
+  bool any() const { return focal_relative > 0 || principal_point_px > 0 || rotation_deg > 0 || translation_m > 0; }
+};
+
+struct Scenario {
+  std::string source;       // file it was read from
+  std::string name;
+  std::string description;
+  WorldSetup world;                    // world.seed is the batch seed; trial i runs with seed + i
+  double map_resolution = 0.05;        // m: the robot's prior map, made from the surveyed garden
+  double map_clearance_height = 1.0;   // m: objects whose lowest point is higher are not obstacles
+  Survey survey;
+  std::vector<Eigen::Vector2d> goals;  // map frame, in order
+  double goal_tolerance = 0.3;         // m: a goal counts as reached within this (ground truth)
+  double initial_position_sigma = 0.1; // m per axis: the stack's start belief = truth + this noise
+  double initial_yaw_sigma = 3.0 * M_PI / 180.0;  // rad
+  CalibrationError calibration_error;
+  int trials = 1;
+  double time_limit = 300.0;           // s of simulated time per trial
+  double wall_time_limit = 1800.0;     // s of wall-clock time per trial before it is killed
+  bool render_cameras = false;         // rendering costs ~0.5-1 s per ring frame
+  double resolution_scale = 0.5;       // when rendering
+  double imu_noise_scale = 1.0;
+  double wheel_slip_scale = 1.0;
+  SimulatedPoseFixParameters simulated_pose_fixes;  // test fixture, used when the stack asks for it
+  std::vector<sim::Fault> faults;
+  std::vector<PassCriterion> criteria;
+  std::optional<YamlMap> stack;        // overrides of robot/config/stack.yaml
+
+  static Scenario Load(const std::string& path);
+};
+
+// Names a criterion may use.
+bool IsKnownMetric(const std::string& name);
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,83 @@
+#include "runner/trial.h"
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+
+#include "eval/simulated_pose_fixes.h"
+#include "eval/trial_evaluator.h"
+#include "runner/closed_loop.h"
+#include "runner/controllers.h"
+#include "runner/prior_knowledge.h"
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/sim/simulator.h"
+#include "trimbot/stack/robot_stack.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+sim::SimulatorConfig PlantFor(const TrialSetup& setup) {
+  const Scenario& scenario = *setup.scenario;
+  WorldSetup world = scenario.world;
+  world.seed = setup.seed;
+  sim::SimulatorConfig config = MakeSimulatorConfig(setup.paths, world, setup.dir + "/world");
+  config.render_cameras = scenario.render_cameras;
+  config.resolution_scale = scenario.resolution_scale;
+  config.faults = scenario.faults;
+  config.imu_noise_scale = scenario.imu_noise_scale;
+  config.wheel_slip_scale = scenario.wheel_slip_scale;
+  return config;
+}
+
+void WriteTiming(const std::string& dir, double wall_seconds, double simulated_seconds, const stack::StackTimings& t) {
+  const nlohmann::json timing = {{"wall_seconds", wall_seconds},
+                                 {"real_time_factor", wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0},
+                                 {"stack_seconds",
+                                  {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}}};
+  WriteFileAtomically(dir + "/timing.json", timing.dump(2));
+}
+
+}  // namespace
+
+TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>& progress) {
+  const Scenario& scenario = *setup.scenario;
+  const auto wall_start = std::chrono::steady_clock::now();
+  std::filesystem::create_directories(setup.dir);
+  TrialResult result;
+  result.index = setup.index;
+  result.seed = setup.seed;
+  for (const auto& fault : scenario.faults) result.faults.push_back(fault.Describe());
+
+  sim::Simulator simulator(PlantFor(setup));
+
+  // The robot's side, from its own files and what the operator knows; never from the simulator.
+  robot::RobotFiles files = setup.paths.robot_files();
+  files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
+  const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
+  stack::RobotStack robot(files, parameters, setup.seed);
+  robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
+  robot.SetMap(setup.map_yaml);
+  robot.SetGoals(scenario.goals);
+
+  std::optional<SimulatedPoseFixes> fixes;
+  if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
+    fixes.emplace(scenario.simulated_pose_fixes, setup.seed);
+  }
+  TrialEvaluator evaluator(scenario.goals, scenario.goal_tolerance, scenario.simulated_pose_fixes.latency_max + 1.0);
+  StackController controller(robot);
+  LoopOptions options;
+  options.time_limit = scenario.time_limit;
+  options.pose_fixes = fixes ? &*fixes : nullptr;
+  options.progress = progress;
+  const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);
+
+  evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
+  result.simulated_seconds = simulator.time();
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  evaluator.WriteFiles(setup.dir);
+  WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
+  WriteTiming(setup.dir, result.wall_seconds, result.simulated_seconds, robot.telemetry().timings);
+  return result;
+}
+
+}  // namespace trimbot::scenarios

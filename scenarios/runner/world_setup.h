@@ -1,0 +1,43 @@
+#pragma once
+// Where the project's data lives, and the one description of the world a run happens in (used by
+// scenarios and drive plans alike), turned into a simulator configuration in one place.
+#include <cstdint>
+#include <string>
+
+#include "trimbot/common/yaml_reader.h"
+#include "trimbot/garden/conditions.h"
+#include "trimbot/robot/robot_files.h"
+#include "trimbot/sim/simulator.h"
+
+namespace trimbot::scenarios {
+
+// The project's data files (robot description, calibration, gardens). Defaults to the source tree
+// the binary was built from; --data-root or TRIMBOT_DATA_ROOT points elsewhere.
+struct ProjectPaths {
+  std::string root;
+
+  std::string robot_dir() const { return root + "/robot"; }
+  robot::RobotFiles robot_files() const { return robot::RobotFiles::InFolder(robot_dir()); }
+  std::string gardens_dir() const { return root + "/garden_scenes/gardens"; }
+
+  static ProjectPaths Default();
+};
+
+// The world of a run: which garden, where the robot really stands at the start, the conditions,
+// and the seed of the run's noise, faults and dynamics.
+struct WorldSetup {
+  std::string garden;             // name in garden_scenes/gardens/ or a file
+  sim::Pose2D start;              // true start pose of base_link (map frame)
+  garden::Conditions conditions;  // time of day, season, growth
+  std::uint64_t seed = 0;
+
+  // Reads `garden`, `start`, `conditions` (and `seed` when `with_seed`) from a scenario or plan.
+  static WorldSetup Read(const YamlMap& root, bool with_seed);
+};
+
+// The simulator configuration for `world` with the project's robot, composing its MuJoCo world in
+// `world_dir`; rendering, noise and faults at their defaults for the caller to set.
+sim::SimulatorConfig MakeSimulatorConfig(const ProjectPaths& paths, const WorldSetup& world,
+                                         const std::string& world_dir);
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,101 @@
+#pragma once
+// The robot software as one system: time-stamped sensor messages in, actuator commands out, and a
+// telemetry record of what it believes and does. It is built from the robot's files only (URDF,
+// camera calibration, robot parameters, stack parameters) and owns its components - wheel
+// odometry, the EKF, the navigator with its planner and path follower, local fusion - and their
+// scheduling; which components run is configuration (StackParameters), not the caller's wiring.
+// Nothing here knows whether the sensors are simulated: the same object could run on the robot.
+//
+// Use:  RobotStack stack(files, parameters, seed);
+//       stack.SetInitialPose(0, believed_start);  stack.SetMap(map_yaml);  stack.SetGoals(goals);
+//       per sensor message: stack.Add(message);   then: commands = stack.Update(now);
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "trimbot/messages/commands.h"
+#include "trimbot/messages/sensor_messages.h"
+#include "trimbot/robot/robot_files.h"
+#include "trimbot/stack/stack_parameters.h"
+
+namespace trimbot::stack {
+
+enum class MissionState { kIdle, kDriving, kDone, kFailed };
+const char* ToString(MissionState state);
+
+// Wall-clock seconds spent in each part of the stack since it started (not deterministic: for
+// timing reports only).
+struct StackTimings {
+  double localization = 0.0;
+  double navigation = 0.0;
+  double perception = 0.0;
+};
+
+// What the stack reports after an update, for logs and evaluation.
+struct Telemetry {
+  double stamp = 0.0;
+  PoseEstimate estimate;                 // EKF, map frame
+  Pose2 odometry;                        // wheel odometry alone, map frame (odom = initial pose)
+  MissionState mission = MissionState::kIdle;
+  int current_goal = 0;
+  std::vector<NavigationEvent> events;   // of the last update
+  EkfCounters localization;              // fixes accepted, rejected, re-localizations
+  int ring_frames = 0;                   // received
+  int pose_fixes_ignored = 0;            // received while no fix source is configured
+  std::optional<perception::CloudRegistration> registration;  // local fusion, in the last update
+  StackTimings timings;
+};
+
+class RobotStack {
+ public:
+  // `seed` seeds the stack's randomized algorithms (the planner's RRT*): same seed, same plans.
+  // Throws InputError naming the file and key when a file is missing or malformed.
+  RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed);
+  ~RobotStack();
+  RobotStack(const RobotStack&) = delete;
+  RobotStack& operator=(const RobotStack&) = delete;
+
+  // Mission inputs, from the operator.
+  // Where the robot was put down, as far as the operator knows (the EKF starts here with the
+  // parameters' initial_pose_sigma); the odom frame starts here too.
+  void SetInitialPose(double stamp, const Pose2& believed_pose);
+  // The prior map of the garden (map_server YAML + PNG); needed before goals.
+  void SetMap(const std::string& map_yaml);
+  // Goals in the map frame, visited in order; navigation starts with the next update.
+  void SetGoals(const std::vector<Eigen::Vector2d>& goals);
+  // Drive by hand: the command passes through to the base (navigation stays idle); the stack
+  // still estimates its pose and runs perception.
+  void SetTeleopCommand(const messages::BaseVelocityCommand& command);
+
+  // Sensor inputs, in time order per sensor.
+  void Add(const messages::ImuSample& imu);
+  void Add(const messages::WheelTicks& ticks);
+  void Add(const messages::ArmJointState& joints);
+  void Add(const messages::RingFrame& frame);
+  void Add(const messages::PoseFix& fix);  // used when localization is simulated_pose_fixes
+
+  // Whether a component would use a ring frame exposed at `stamp` (so a driver can skip the rest).
+  bool WantsRingFrame(double stamp) const;
+
+  // Runs the components due at `stamp` (the latest sensor time) and returns the commands.
+  messages::RobotCommands Update(double stamp);
+
+  const Telemetry& telemetry() const { return telemetry_; }
+  const StackParameters& parameters() const { return parameters_; }
+
+ private:
+  void RunNavigation(double stamp, messages::RobotCommands* commands);
+
+  StackParameters parameters_;
+  struct Components;
+  std::unique_ptr<Components> components_;
+  Telemetry telemetry_;
+  double next_control_ = 0.0;
+  std::optional<messages::BaseVelocityCommand> teleop_;
+  std::optional<perception::CloudRegistration> pending_registration_;  // reported by the next update
+};
+
+}  // namespace trimbot::stack

@@ -1,0 +1,176 @@
+#include "trimbot/stack/robot_stack.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "trimbot/common/input_error.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_parameters.h"
+#include "trimbot/stack/ekf.h"
+#include "trimbot/stack/global_planner.h"
+#include "trimbot/stack/navigator.h"
+#include "trimbot/stack/occupancy_grid.h"
+#include "trimbot/stack/wheel_odometry.h"
+
+namespace trimbot::stack {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Adds the wall-clock time of a scope to a timing counter.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double* total) : total_(total), start_(Clock::now()) {}
+  ~ScopedTimer() { *total_ += std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+ private:
+  double* total_;
+  Clock::time_point start_;
+};
+
+MissionState ToMission(Navigator::Mode mode) {
+  switch (mode) {
+    case Navigator::Mode::kIdle: return MissionState::kIdle;
+    case Navigator::Mode::kFollowing:
+    case Navigator::Mode::kBackingOff: return MissionState::kDriving;
+    case Navigator::Mode::kDone: return MissionState::kDone;
+    case Navigator::Mode::kFailed: return MissionState::kFailed;
+  }
+  return MissionState::kIdle;
+}
+
+}  // namespace
+
+const char* ToString(MissionState state) {
+  switch (state) {
+    case MissionState::kIdle: return "idle";
+    case MissionState::kDriving: return "driving";
+    case MissionState::kDone: return "done";
+    case MissionState::kFailed: return "failed";
+  }
+  return "?";
+}
+
+struct RobotStack::Components {
+  robot::RobotDescription description;
+  robot::CameraRig rig;
+  int ticks_per_revolution = 0;
+  WheelOdometry odometry;
+  Ekf ekf;
+  Pose2 odom_origin;                              // map pose of the odom frame
+  std::unique_ptr<OccupancyGrid> map;
+  std::unique_ptr<Navigator> navigator;
+  std::unique_ptr<perception::LocalFusion> fusion;
+
+  Components(const robot::RobotFiles& files, const StackParameters& parameters)
+      : description(robot::RobotDescription::Load(files.urdf)),
+        rig(robot::CameraRig::LoadKalibr(files.camchain,
+                                         description.FramePose(robot::RobotFrames::CameraOptical(0)))),
+        ticks_per_revolution(robot::RobotParameters::Load(files.robot_parameters).wheel_encoders.ticks_per_revolution),
+        odometry(description.drive(), ticks_per_revolution),
+        ekf(parameters.ekf, description.drive(), ticks_per_revolution) {
+    if (parameters.local_fusion.enabled) fusion = std::make_unique<perception::LocalFusion>(rig, parameters.local_fusion);
+  }
+};
+
+RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed)
+    : parameters_(parameters), components_(std::make_unique<Components>(files, parameters)) {
+  SeedPlanner(seed);
+  next_control_ = 1.0 / parameters_.control_rate_hz;
+}
+
+RobotStack::~RobotStack() = default;
+
+void RobotStack::SetInitialPose(double stamp, const Pose2& believed_pose) {
+  const double p = parameters_.initial_position_sigma, yaw = parameters_.initial_yaw_sigma;
+  components_->ekf.Initialize(stamp, believed_pose, Eigen::Vector3d(p * p, p * p, yaw * yaw).asDiagonal());
+  components_->odom_origin = believed_pose;
+  telemetry_.estimate = components_->ekf.Estimate();
+  telemetry_.odometry = believed_pose;
+}
+
+void RobotStack::SetMap(const std::string& map_yaml) {
+  components_->navigator.reset();
+  components_->map = std::make_unique<OccupancyGrid>(OccupancyGrid::LoadMapServer(map_yaml));
+  components_->navigator = std::make_unique<Navigator>(*components_->map, parameters_.navigation);
+}
+
+void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
+  if (!components_->navigator) throw std::logic_error("RobotStack::SetGoals: no map (call SetMap first)");
+  components_->navigator->SetGoals(goals);
+  teleop_.reset();
+}
+
+void RobotStack::SetTeleopCommand(const messages::BaseVelocityCommand& command) { teleop_ = command; }
+
+void RobotStack::Add(const messages::ImuSample& imu) {
+  ScopedTimer timer(&telemetry_.timings.localization);
+  components_->ekf.AddImu(imu);
+}
+
+void RobotStack::Add(const messages::WheelTicks& ticks) {
+  ScopedTimer timer(&telemetry_.timings.localization);
+  components_->ekf.AddWheelTicks(ticks);
+  components_->odometry.Update(ticks);
+}
+
+void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
+  // No arm software yet (the arm stack will track its joints here).
+}
+
+void RobotStack::Add(const messages::RingFrame& frame) {
+  ++telemetry_.ring_frames;
+  if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
+    ScopedTimer timer(&telemetry_.timings.perception);
+    // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
+    pending_registration_ = components_->fusion->Add(frame, ToIsometry(components_->odometry.pose()));
+  }
+}
+
+void RobotStack::Add(const messages::PoseFix& fix) {
+  if (parameters_.localization != LocalizationSource::kSimulatedPoseFixes) {
+    ++telemetry_.pose_fixes_ignored;
+    return;
+  }
+  ScopedTimer timer(&telemetry_.timings.localization);
+  components_->ekf.AddPoseFix(fix);
+}
+
+bool RobotStack::WantsRingFrame(double stamp) const {
+  return components_->fusion != nullptr && components_->fusion->Wants(stamp);
+}
+
+messages::RobotCommands RobotStack::Update(double stamp) {
+  Components& c = *components_;
+  messages::RobotCommands commands;
+  telemetry_.events.clear();
+  telemetry_.registration = std::move(pending_registration_);
+  pending_registration_.reset();
+  if (stamp + 1e-9 >= next_control_) {
+    // Control ticks at whole multiples of the period (no drift from summing periods).
+    next_control_ = (std::floor((stamp + 1e-9) * parameters_.control_rate_hz) + 1.0) / parameters_.control_rate_hz;
+    RunNavigation(stamp, &commands);
+  }
+  telemetry_.stamp = stamp;
+  telemetry_.estimate = c.ekf.Estimate();
+  telemetry_.odometry = ToPose2(ToIsometry(c.odom_origin) * ToIsometry(c.odometry.pose()));
+  telemetry_.localization = c.ekf.counters();
+  return commands;
+}
+
+void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) {
+  if (teleop_) {
+    commands->base = *teleop_;
+    return;
+  }
+  Navigator* navigator = components_->navigator.get();
+  if (navigator == nullptr) return;
+  ScopedTimer timer(&telemetry_.timings.navigation);
+  commands->base = navigator->Update(stamp, components_->ekf.Estimate().pose);
+  telemetry_.events = navigator->TakeEvents();
+  telemetry_.mission = ToMission(navigator->mode());
+  telemetry_.current_goal = navigator->current_goal();
+}
+
+}  // namespace trimbot::stack

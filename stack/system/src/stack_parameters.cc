@@ -1,0 +1,172 @@
+#include "trimbot/stack/stack_parameters.h"
+
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace trimbot::stack {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kDegree = M_PI / 180.0;
+
+// Reads keys into fields that already hold their defaults. In a complete file every key must be
+// there; in an override only the keys present are read. Either way unknown keys are errors.
+class Reader {
+ public:
+  Reader(YamlMap map, bool complete) : map_(std::move(map)), complete_(complete) {}
+
+  void Number(const char* key, double* value, double lo, double hi, const char* unit = "") {
+    if (Wanted(key)) *value = map_.Number(key, lo, hi, unit);
+  }
+  void Degrees(const char* key, double* radians, double lo_deg, double hi_deg) {
+    double degrees = *radians / kDegree;
+    Number(key, &degrees, lo_deg, hi_deg, "deg");
+    *radians = degrees * kDegree;
+  }
+  void Integer(const char* key, int* value, int lo, int hi) {
+    if (Wanted(key)) *value = map_.Integer(key, lo, hi);
+  }
+  void Flag(const char* key, bool* value) {
+    if (Wanted(key)) *value = map_.Bool(key);
+  }
+  template <typename Body>
+  void Section(const char* key, Body body) {
+    if (!Wanted(key)) return;
+    Reader section(map_.Map(key), complete_);
+    body(section);
+    section.map_.RejectUnknownKeys();
+  }
+  const YamlMap& map() const { return map_; }
+  bool Wanted(const char* key) const { return complete_ || map_.Has(key); }
+
+ private:
+  YamlMap map_;
+  bool complete_;
+};
+
+void ReadEkf(Reader& r, EkfParameters& p) {
+  r.Number("linear_acceleration_density", &p.linear_acceleration_density, 0.0, 100.0, "m/s^2/sqrt(Hz)");
+  r.Number("angular_acceleration_density", &p.angular_acceleration_density, 0.0, 100.0, "rad/s^2/sqrt(Hz)");
+  r.Number("gyro_bias_random_walk", &p.gyro_bias_random_walk, 0.0, 1.0, "rad/s^2/sqrt(Hz)");
+  r.Number("wheel_speed_sigma", &p.wheel_speed_sigma, 1e-6, 10.0, "m/s");
+  r.Number("wheel_slip_fraction", &p.wheel_slip_fraction, 0.0, 1.0);
+  r.Number("gyro_sigma", &p.gyro_sigma, 1e-6, 10.0, "rad/s");
+  r.Number("fix_gate_chi2", &p.fix_gate_chi2, 0.0, kInf);
+  r.Integer("relocalize_after_rejections", &p.relocalize_after_rejections, 1, 1000);
+  r.Number("relocalize_consistency", &p.relocalize_consistency, 0.0, 100.0, "m");
+  r.Number("history_seconds", &p.history_seconds, 0.1, 60.0, "s");
+  r.Number("max_fix_lead", &p.max_fix_lead, 0.0, 10.0, "s");
+}
+
+void ReadFootprint(Reader& r, Footprint& p) {
+  if (r.Wanted("circle_x")) {
+    p.circle_x = r.map().Doubles("circle_x");
+    if (p.circle_x.empty()) r.map().Fail("circle_x", "needs at least one circle");
+    for (double x : p.circle_x) {
+      if (!std::isfinite(x) || std::abs(x) > 5.0) r.map().Fail("circle_x", "values must be finite and within 5 m");
+    }
+  }
+  r.Number("circle_radius", &p.circle_radius, 0.01, 5.0, "m");
+}
+
+void ReadPlanner(Reader& r, PlannerParameters& p) {
+  r.Number("robot_radius", &p.robot_radius, 0.0, 5.0, "m");
+  r.Number("footprint_margin", &p.footprint_margin, 0.0, 2.0, "m");
+  r.Number("start_footprint_free", &p.start_footprint_free, 0.0, 5.0, "m");
+  r.Integer("iterations", &p.iterations, 10, 10000000);
+  r.Number("range", &p.range, 0.05, 100.0, "m");
+  r.Number("start_escape_radius", &p.start_escape_radius, 0.0, 10.0, "m");
+}
+
+void ReadFollower(Reader& r, FollowerParameters& p) {
+  r.Number("cruise_speed", &p.cruise_speed, 0.01, 0.6, "m/s (the base's limit is 0.6)");
+  r.Number("lookahead", &p.lookahead, 0.05, 10.0, "m");
+  r.Number("max_angular_speed", &p.max_angular_speed, 0.01, 1.5, "rad/s");
+  r.Number("align_tolerance", &p.align_tolerance, 0.001, M_PI, "rad");
+  r.Number("turn_in_place_above", &p.turn_in_place_above, 0.0, M_PI, "rad");
+  r.Number("heading_gain", &p.heading_gain, 0.01, 100.0, "1/s");
+  r.Number("sharp_turn", &p.sharp_turn, 0.0, M_PI, "rad");
+  r.Number("vertex_tolerance", &p.vertex_tolerance, 0.001, 1.0, "m");
+  r.Number("goal_tolerance", &p.goal_tolerance, 0.001, 2.0, "m");
+  r.Number("slow_down_distance", &p.slow_down_distance, 0.0, 10.0, "m");
+  r.Number("min_speed", &p.min_speed, 0.001, 0.6, "m/s");
+}
+
+void ReadNavigation(Reader& r, StackParameters& s) {
+  NavigatorParameters& p = s.navigation;
+  r.Number("control_rate_hz", &s.control_rate_hz, 1.0, 400.0, "Hz");
+  r.Section("footprint", [&](Reader& f) { ReadFootprint(f, p.planner.footprint); });
+  r.Section("planner", [&](Reader& f) { ReadPlanner(f, p.planner); });
+  r.Section("follower", [&](Reader& f) { ReadFollower(f, p.follower); });
+  r.Number("stop_clearance", &p.stop_clearance, -1.0, 2.0, "m");
+  r.Number("resume_clearance", &p.resume_clearance, 0.0, 5.0, "m");
+  r.Number("backoff_speed", &p.backoff_speed, 0.01, 0.6, "m/s");
+  r.Number("max_backoff", &p.max_backoff, 0.0, 10.0, "m");
+  r.Number("replan_deviation", &p.replan_deviation, 0.01, 100.0, "m");
+  r.Integer("max_recoveries_per_goal", &p.max_recoveries_per_goal, 0, 1000);
+  r.Integer("max_plan_failures", &p.max_plan_failures, 1, 1000);
+  if (p.resume_clearance < p.stop_clearance) r.map().Fail("resume_clearance", "must be at least stop_clearance");
+  if (p.follower.min_speed > p.follower.cruise_speed) {
+    r.map().Fail("follower", "min_speed must not exceed cruise_speed");
+  }
+}
+
+void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
+  const std::string name = map.String("localization");
+  if (name == "none") {
+    *source = LocalizationSource::kNone;
+  } else if (name == "simulated_pose_fixes") {
+    *source = LocalizationSource::kSimulatedPoseFixes;
+  } else {
+    map.Fail("localization", "unknown source '" + name + "' (none, simulated_pose_fixes)");
+  }
+}
+
+void Read(Reader& r, StackParameters& s) {
+  if (r.Wanted("localization")) ReadLocalization(r.map(), &s.localization);
+  r.Section("initial_pose_sigma", [&](Reader& f) {
+    f.Number("position", &s.initial_position_sigma, 1e-4, 100.0, "m");
+    f.Degrees("yaw_deg", &s.initial_yaw_sigma, 0.01, 180.0);
+  });
+  r.Section("ekf", [&](Reader& f) { ReadEkf(f, s.ekf); });
+  r.Section("navigation", [&](Reader& f) { ReadNavigation(f, s); });
+  r.Section("perception", [&](Reader& perception) {
+    perception.Section("local_fusion", [&](Reader& f) {
+      perception::LocalFusionOptions& p = s.local_fusion;
+      f.Flag("enabled", &p.enabled);
+      f.Number("interval", &p.interval, 0.05, 3600.0, "s");
+      f.Integer("stride", &p.stride, 1, 64);
+      f.Number("ground_keep", &p.ground_keep, 0.0, 1.0);
+    });
+  });
+}
+
+}  // namespace
+
+const char* ToString(LocalizationSource source) {
+  switch (source) {
+    case LocalizationSource::kNone: return "none";
+    case LocalizationSource::kSimulatedPoseFixes: return "simulated_pose_fixes";
+  }
+  return "?";
+}
+
+StackParameters StackParameters::Load(const std::string& path) {
+  const YamlMap root = YamlMap::LoadFile(path);
+  StackParameters parameters;
+  Reader reader(root, /*complete=*/true);
+  Read(reader, parameters);
+  reader.map().RejectUnknownKeys();
+  return parameters;
+}
+
+StackParameters StackParameters::Overridden(const YamlMap& section) const {
+  StackParameters parameters = *this;
+  Reader reader(section, /*complete=*/false);
+  Read(reader, parameters);
+  reader.map().RejectUnknownKeys();
+  return parameters;
+}
+
+}  // namespace trimbot::stack
