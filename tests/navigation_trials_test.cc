@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -14,8 +15,11 @@
 #include "runner/prior_knowledge.h"
 #include "runner/trial.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/garden/garden_tools.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/occupancy_grid.h"
 
@@ -74,6 +78,67 @@ TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
     EXPECT_LT(closest, radius) << "straight path from " << from.transpose() << " to " << goal.transpose();
     from = goal;
   }
+}
+
+// The prior map is the garden as surveyed: unmapped objects are missing from it, objects that are
+// gone are still in it, foliage is as big as it was at the survey.
+TEST(PriorKnowledge, TheMapIsTheGardenAsSurveyed) {
+  const garden::Garden built = garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml"));
+  Survey survey;
+  survey.growth = 1.0;
+  survey.unmapped = {17};
+  garden::GardenObject gone;
+  gone.id = 900;
+  gone.size = Eigen::Vector3d(0.5, 0.5, 0.5);
+  gone.position = Eigen::Vector2d(0.0, 3.0);
+  survey.gone = {gone};
+  const garden::Garden surveyed = SurveyedGarden(built, survey, "test.yaml");
+  EXPECT_EQ(surveyed.objects.size(), built.objects.size());  // one out, one in
+  const auto find = [](const garden::Garden& g, int id) {
+    return std::find_if(g.objects.begin(), g.objects.end(), [id](const auto& o) { return o.id == id; });
+  };
+  EXPECT_EQ(find(surveyed, 17), surveyed.objects.end());
+  EXPECT_NE(find(surveyed, 900), surveyed.objects.end());
+  const auto built_bush = find(built, 9), surveyed_bush = find(surveyed, 9);  // topiary
+  EXPECT_NEAR(surveyed_bush->size.x() - built_bush->size.x(), 2 * garden::kMaxGrowth, 1e-12);
+  EXPECT_EQ(surveyed_bush->size.z(), built_bush->size.z());
+  const auto fence = find(built, 5);
+  EXPECT_EQ(find(surveyed, 5)->size, fence->size) << "a fence does not grow";
+  survey.unmapped = {12345};
+  EXPECT_THROW(SurveyedGarden(built, survey, "test.yaml"), InputError);
+}
+
+// The stack starts from the true start plus the seeded placement error, and reads a calibration
+// with the seeded calibration error; the simulator keeps the true one.
+TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
+  const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
+  Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle.yaml"));
+  const stack::Pose2 a = BelievedStart(s, 1), b = BelievedStart(s, 1), c = BelievedStart(s, 2);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_NE(a.x, c.x);
+  const double error = std::hypot(a.x - s.world.start.x, a.y - s.world.start.y);
+  EXPECT_GT(error, 0.0);
+  EXPECT_LT(error, 5 * s.initial_position_sigma);
+
+  EXPECT_EQ(StackCalibration(s, paths, 1, testing::TempDir("calibration")), paths.robot_files().camchain);
+  s.calibration_error.focal_relative = 0.01;
+  s.calibration_error.rotation_deg = 0.5;
+  const std::string perturbed = StackCalibration(s, paths, 1, testing::TempDir("calibration"));
+  const robot::RobotDescription description = robot::RobotDescription::Load(paths.robot_files().urdf);
+  const Eigen::Isometry3d T_base_cam0 = description.FramePose(robot::RobotFrames::CameraOptical(0));
+  const robot::CameraRig truth = robot::CameraRig::LoadKalibr(paths.robot_files().camchain, T_base_cam0);
+  const robot::CameraRig read = robot::CameraRig::LoadKalibr(perturbed, T_base_cam0);
+  ASSERT_EQ(read.size(), truth.size());
+  double worst_focal = 0.0, worst_angle = 0.0;
+  for (int i = 0; i < truth.size(); ++i) {
+    worst_focal = std::max(worst_focal, std::abs(read.camera(i).intrinsics.fx / truth.camera(i).intrinsics.fx - 1.0));
+    const Eigen::AngleAxisd delta(truth.camera(i).T_base_camera.linear().transpose() * read.camera(i).T_base_camera.linear());
+    worst_angle = std::max(worst_angle, delta.angle() * 180.0 / M_PI);
+  }
+  EXPECT_GT(worst_focal, 0.001);
+  EXPECT_LT(worst_focal, 0.05);
+  EXPECT_GT(worst_angle, 0.05);
+  EXPECT_LT(worst_angle, 3.0);
 }
 
 TEST(Scenario, BadFilesNameTheFileLineAndKey) {
