@@ -141,6 +141,18 @@ TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   EXPECT_LT(worst_angle, 3.0);
 }
 
+TEST(Scenario, FixtureSettingsWithoutTheFixtureAreAnInputError) {
+  const Scenario s = Scenario::Load(SmokeVariant("unused_fixes.yaml", "time_limit: 60.0",
+                                                 "time_limit: 60.0\nsimulated_pose_fixes: {availability: 0.5}"));
+  try {
+    StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unused_fixes.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("localization is 'none'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scenario, BadFilesNameTheFileLineAndKey) {
   const struct {
     std::string replace, with, expected;

@@ -98,7 +98,13 @@ std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths
 
 stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths) {
   const stack::StackParameters defaults = stack::StackParameters::Load(paths.robot_files().stack_parameters);
-  return scenario.stack ? defaults.Overridden(*scenario.stack) : defaults;
+  const stack::StackParameters parameters = scenario.stack ? defaults.Overridden(*scenario.stack) : defaults;
+  if (scenario.simulated_pose_fixes_given && parameters.localization != stack::LocalizationSource::kSimulatedPoseFixes) {
+    throw InputError(scenario.source, std::string("simulated_pose_fixes: settings given, but the stack's localization is '") +
+                                          stack::ToString(parameters.localization) +
+                                          "' (set stack: {localization: simulated_pose_fixes} to use them)");
+  }
+  return parameters;
 }
 
 }  // namespace trimbot::scenarios

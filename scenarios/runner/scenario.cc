@@ -120,7 +120,10 @@ void ReadPlant(const YamlMap& root, Scenario& s) {
     s.wheel_slip_scale = noise.NumberOr("wheel_slip", 1.0, 0.0, 100.0);
     noise.RejectUnknownKeys();
   }
-  if (root.Has("simulated_pose_fixes")) s.simulated_pose_fixes = ReadSimulatedPoseFixes(root.Map("simulated_pose_fixes"));
+  if (root.Has("simulated_pose_fixes")) {
+    s.simulated_pose_fixes = ReadSimulatedPoseFixes(root.Map("simulated_pose_fixes"));
+    s.simulated_pose_fixes_given = true;
+  }
   if (root.Has("faults")) {
     for (const YamlMap& item : root.MapList("faults")) s.faults.push_back(ReadFault(item));
   }

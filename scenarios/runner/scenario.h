@@ -63,6 +63,7 @@ struct Scenario {
   double imu_noise_scale = 1.0;
   double wheel_slip_scale = 1.0;
   SimulatedPoseFixParameters simulated_pose_fixes;  // test fixture, used when the stack asks for it
+  bool simulated_pose_fixes_given = false;          // the file set them (then the stack must use them)
   std::vector<sim::Fault> faults;
   std::vector<PassCriterion> criteria;
   std::optional<YamlMap> stack;        // overrides of robot/config/stack.yaml
