@@ -21,6 +21,9 @@ void AddBatchCommands(CLI::App& app, const std::string& data_root, int& exit_cod
   run->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
   run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
+  run->add_option("--set", options->overrides,
+                  "override a scenario or stack parameter, key.path=value (repeatable), e.g. "
+                  "--set stack.navigation.follower.cruise_speed=0.3 --set trials=3");
   run->callback([options, trials, seed, shard, trials_option, seed_option, &data_root, &exit_code]() {
     options->paths = {data_root};
     if (trials_option->count() > 0) options->trials = *trials;

@@ -5,11 +5,13 @@
 
 #include "cli/batch_command.h"
 #include "cli/bench_command.h"
+#include "cli/compare_command.h"
 #include "cli/drive_command.h"
 #include "cli/fusion_command.h"
 #include "cli/garden_command.h"
 #include "cli/registration_command.h"
 #include "cli/stereo_command.h"
+#include "cli/tuning_commands.h"
 #include "trimbot/common/input_error.h"
 
 int main(int argc, char** argv) {
@@ -47,6 +49,8 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   AddBatchCommands(app, data_root, exit_code);
   AddRegistrationCommand(app, exit_code);
+  AddCompareCommand(app, exit_code);
+  AddTuningCommands(app, data_root, exit_code);
   AddFusionCommand(app, data_root, exit_code);
   AddStereoCommand(app, data_root);
 

@@ -110,6 +110,7 @@ void to_json(nlohmann::json& j, const CriterionResult& c) {
 void to_json(nlohmann::json& j, const BatchSummary& b) {
   j = {{"scenario", b.scenario},
        {"scenario_file", b.scenario_file},
+       {"overrides", b.overrides},
        {"seed", b.seed},
        {"trials_planned", b.trials_planned},
        {"pass", b.pass},

@@ -64,6 +64,7 @@ struct CriterionResult {
 struct BatchSummary {
   std::string scenario;        // scenario name
   std::string scenario_file;
+  std::vector<std::string> overrides;  // --set key=value the batch ran with
   std::uint64_t seed = 0;      // batch seed; trial seeds are in the trials
   int trials_planned = 0;
   std::vector<TrialResult> trials;

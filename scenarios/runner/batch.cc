@@ -39,10 +39,11 @@ struct BatchInfo {
   std::uint64_t seed = 0;
   int trials = 0;
   int shard_index = 0, shard_count = 1;
+  std::vector<std::string> overrides;   // --set, as given
 };
 
 json ToJson(const BatchInfo& info) {
-  return {{"scenario_file", info.scenario_file}, {"seed", info.seed}, {"trials", info.trials},
+  return {{"scenario_file", info.scenario_file}, {"seed", info.seed}, {"trials", info.trials}, {"overrides", info.overrides},
           {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)}};
 }
 
@@ -64,6 +65,7 @@ BatchInfo ReadBatchInfo(const std::string& dir) {
     info.scenario_file = j.at("scenario_file").get<std::string>();
     info.seed = j.at("seed").get<std::uint64_t>();
     info.trials = j.at("trials").get<int>();
+    if (j.contains("overrides")) info.overrides = j.at("overrides").get<std::vector<std::string>>();
     std::tie(info.shard_index, info.shard_count) = ParseShard(j.at("shard").get<std::string>(), path);
     return info;
   } catch (const json::exception& e) {
@@ -129,11 +131,12 @@ void WriteTiming(const std::string& out, const std::vector<TrialResult>& results
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.
 int WriteReports(const std::string& out, const Scenario& scenario, const garden::OccupancyMap& map,
-                 const BatchInfo& info, std::vector<TrialResult> results, int trials_planned) {
+                 const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   BatchSummary summary;
   summary.scenario = scenario.name;
   summary.scenario_file = info.scenario_file;
+  summary.overrides = info.overrides;
   summary.seed = info.seed;
   summary.trials_planned = trials_planned;
   summary.trials = results;
@@ -164,14 +167,14 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
                       scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
   WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
 
-  std::cout << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
-  for (const auto& r : results) std::cout << "  " << OneLine(r) << "\n";
-  std::cout << "criteria:\n";
+  log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
+  for (const auto& r : results) log << "  " << OneLine(r) << "\n";
+  log << "criteria:\n";
   for (const auto& c : summary.criteria) {
-    std::cout << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
+    log << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
               << " (actual " << c.actual << ")\n";
   }
-  std::cout << "outputs in " << out << " (summary.json, junit.xml, trajectories.png, localization_errors.png)\n";
+  log << "outputs in " << out << " (summary.json, junit.xml, trajectories.png, localization_errors.png)\n";
   return summary.pass ? 0 : 1;
 }
 
@@ -301,7 +304,7 @@ void PrintProgress(const std::vector<RunningTrial>& running, std::size_t done, i
 
 int RunBatch(const BatchOptions& options) {
   // Every input is read and checked before the output folder is touched.
-  const Scenario scenario = Scenario::Load(options.scenario_path);
+  const Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
   StackParametersFor(scenario, options.paths);
   const garden::OccupancyMap map = PriorMap(scenario, options.paths);
   const std::string& out = options.out_dir;
@@ -311,13 +314,13 @@ int RunBatch(const BatchOptions& options) {
   info.trials = options.trials.value_or(scenario.trials);
   info.shard_index = options.shard_index;
   info.shard_count = options.shard_count;
+  info.overrides = scenario.overrides;
   if (info.trials < 1) throw InputError(options.scenario_path, "--trials must be at least 1");
   if (options.jobs < 1) throw InputError(options.scenario_path, "--jobs must be at least 1");
-  const std::string scenario_text = ReadText(options.scenario_path);
 
   fs::create_directories(out);
   WriteFileAtomically(out + "/batch.json", ToJson(info).dump(2));
-  WriteFileAtomically(out + "/scenario.yaml", scenario_text);
+  WriteFileAtomically(out + "/scenario.yaml", scenario.effective_yaml);
   WritePriorMap(map, out + "/map");
 
   std::vector<int> queue = ShardTrials(info);
@@ -326,8 +329,10 @@ int RunBatch(const BatchOptions& options) {
 
   // Children are reaped here: an inherited SIGCHLD=SIG_IGN would make the kernel reap them first.
   signal(SIGCHLD, SIG_DFL);
-  const bool interactive = isatty(STDOUT_FILENO) != 0;
-  std::cout << "[run] " << scenario.name << ": " << planned << " trials (shard " << info.shard_index << "/"
+  std::ostream null_log(nullptr);  // writes nothing
+  std::ostream& log = options.quiet ? null_log : std::cout;
+  const bool interactive = !options.quiet && isatty(STDOUT_FILENO) != 0;
+  log << "[run] " << scenario.name << ": " << planned << " trials (shard " << info.shard_index << "/"
             << info.shard_count << ", seeds " << info.seed << "+i), " << options.jobs << " at a time -> " << out
             << std::endl;
   const auto batch_start = Clock::now();
@@ -358,13 +363,13 @@ int RunBatch(const BatchOptions& options) {
       if (!options.keep_worlds) fs::remove_all(it->dir + "/world");
       fs::remove(it->dir + "/progress");
       results.push_back(*result);
-      if (interactive) std::cout << "\r\033[K";
-      std::cout << "[run] " << OneLine(results.back()) << std::endl;
+      if (interactive) log << "\r\033[K";
+      log << "[run] " << OneLine(results.back()) << std::endl;
       it = running.erase(it);
     }
     if (interactive && !running.empty()) PrintProgress(running, results.size(), planned, scenario, batch_start);
   }
-  return WriteReports(out, scenario, map, info, results, planned);
+  return WriteReports(out, scenario, map, info, results, planned, log);
 }
 
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths) {
@@ -408,7 +413,7 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
               << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
-  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), merged, found, merged.trials);
+  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), merged, found, merged.trials, std::cout);
 }
 
 }  // namespace trimbot::scenarios

@@ -32,6 +32,8 @@ struct BatchOptions {
   int jobs = 1;
   int shard_index = 0, shard_count = 1;
   bool keep_worlds = false;             // keep each trial's composed MuJoCo world (large textures)
+  std::vector<std::string> overrides;   // --set key.path=value, applied to the scenario file
+  bool quiet = false;                   // no per-trial lines or report listing (sweeps, tuning)
 };
 
 // Runs the batch (or this shard of it) and writes the reports. Returns the exit code: 0 when every

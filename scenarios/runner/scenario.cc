@@ -1,6 +1,8 @@
 #include "runner/scenario.h"
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include "trimbot/common/yaml_reader.h"
@@ -163,10 +165,26 @@ bool IsKnownMetric(const std::string& name) {
   return kMetrics.count(name) > 0;
 }
 
-Scenario Scenario::Load(const std::string& path) {
-  const YamlMap root = YamlMap::LoadFile(path);
+Scenario Scenario::Load(const std::string& path, const std::vector<Override>& overrides) {
+  const YamlMap file = YamlMap::LoadFile(path);
   Scenario s;
   s.source = path;
+  std::ifstream text(path);
+  s.effective_yaml.assign(std::istreambuf_iterator<char>(text), std::istreambuf_iterator<char>());
+  YAML::Node tree = file.node();
+  if (!overrides.empty()) {
+    tree = YAML::Clone(file.node());
+    ApplyOverrides(tree, overrides, path);
+    YAML::Emitter emitter;
+    emitter << tree;
+    s.effective_yaml = "# " + path + " with";
+    for (const auto& o : overrides) {
+      s.effective_yaml += " --set " + o.text;
+      s.overrides.push_back(o.text);
+    }
+    s.effective_yaml += "\n" + std::string(emitter.c_str()) + "\n";
+  }
+  const YamlMap root(tree, overrides.empty() ? path : path + " (with --set)", "");
   s.name = root.String("name");
   s.description = root.String("description", "");
   s.world = WorldSetup::Read(root, /*with_seed=*/true);

@@ -13,6 +13,7 @@
 
 #include "eval/simulated_pose_fixes.h"
 #include "runner/world_setup.h"
+#include "trimbot/common/overrides.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/sim/faults.h"
@@ -67,8 +68,11 @@ struct Scenario {
   std::vector<sim::Fault> faults;
   std::vector<PassCriterion> criteria;
   std::optional<YamlMap> stack;        // overrides of robot/config/stack.yaml
+  std::vector<std::string> overrides;  // --set key=value, as given (recorded with the results)
+  std::string effective_yaml;          // the file with the overrides applied (a batch's scenario.yaml)
 
-  static Scenario Load(const std::string& path);
+  // Reads the file with `overrides` applied first, so they are checked like the file's own keys.
+  static Scenario Load(const std::string& path, const std::vector<Override>& overrides = {});
 };
 
 // Names a criterion may use.

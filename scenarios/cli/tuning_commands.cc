@@ -1,0 +1,66 @@
+#include "cli/tuning_commands.h"
+
+#include <memory>
+
+#include "runner/sweep.h"
+#include "runner/tune.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+void AddSweep(CLI::App& app, const std::string& data_root, int& exit_code) {
+  auto options = std::make_shared<SweepOptions>();
+  auto trials = std::make_shared<int>(0);
+  auto seed = std::make_shared<std::uint64_t>(0);
+  auto* sweep = app.add_subcommand("sweep", "run a scenario over the product of parameter grids, with 95 % intervals");
+  sweep->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
+  sweep->add_option("--grid", options->grids, "key.path=v1,v2,... (repeatable; the product is swept)")->required();
+  sweep->add_option("--out", options->out_dir, "output folder")->required();
+  auto* trials_option = sweep->add_option("--trials", *trials, "trials per point (default: the scenario's)")
+                            ->check(CLI::PositiveNumber);
+  auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
+  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
+  sweep->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
+    options->paths = {data_root};
+    if (trials_option->count() > 0) options->trials = *trials;
+    if (seed_option->count() > 0) options->seed = *seed;
+    exit_code = RunSweep(*options);
+  });
+}
+
+void AddTune(CLI::App& app, const std::string& data_root, int& exit_code) {
+  auto options = std::make_shared<TuneOptions>();
+  auto trials = std::make_shared<int>(0);
+  auto seed = std::make_shared<std::uint64_t>(0);
+  auto* tune = app.add_subcommand("tune", "tune parameters of a scenario with a derivative-free optimizer (NLopt)");
+  tune->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
+  tune->add_option("--space", options->space_path, "parameter space (YAML: parameters with key, min, max, log, integer)")
+      ->required();
+  tune->add_option("--objective", options->objective, "batch metric to optimize, e.g. ekf_position_error_mean_m")
+      ->required();
+  tune->add_flag("--maximize", options->maximize, "maximize the objective (default: minimize)");
+  tune->add_option("--method", options->method, "bobyqa (local) or direct (global DIRECT-L)");
+  tune->add_option("--budget", options->budget_trials, "trials the search may use")->check(CLI::PositiveNumber);
+  auto* trials_option = tune->add_option("--trials", *trials, "trials per evaluation (default: the scenario's)")
+                            ->check(CLI::PositiveNumber);
+  auto* seed_option = tune->add_option("--seed", *seed, "seed of the tuning trials (the same at every point)");
+  tune->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  tune->add_option("--out", options->out_dir, "output folder")->required();
+  tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
+  tune->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
+    options->paths = {data_root};
+    if (trials_option->count() > 0) options->trials = *trials;
+    if (seed_option->count() > 0) options->seed = *seed;
+    exit_code = RunTune(*options);
+  });
+}
+
+}  // namespace
+
+void AddTuningCommands(CLI::App& app, const std::string& data_root, int& exit_code) {
+  AddSweep(app, data_root, exit_code);
+  AddTune(app, data_root, exit_code);
+}
+
+}  // namespace trimbot::scenarios
