@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <map>
 
 #include "sim_test_support.h"
@@ -228,6 +230,41 @@ TEST(Contacts, DrivingIntoTheHedgeIsReported) {
   ASSERT_FALSE(contacts.empty());
   EXPECT_EQ(contacts.front().object_class, garden::ObjectClass::kHedge);
   EXPECT_NEAR(simulator.ground_truth().T_map_base.translation().x(), 8.2 - 0.58, 0.05);
+}
+
+}  // namespace
+}  // namespace trimbot::sim
+
+namespace trimbot::sim {
+namespace {
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The garden looks the same in every run: its textures and foliage come from the garden's own
+// seed, the run's seed only from sensor noise, faults and dynamics.
+TEST(World, TheGardensLookDoesNotDependOnTheRunSeed) {
+  SimulatorConfig a = TestConfig(TestLawn(), "look_a"), b = TestConfig(TestLawn(), "look_b");
+  a.seed = 1;
+  b.seed = 2;
+  { Simulator first(a); }
+  { Simulator second(b); }
+  for (const char* texture : {"grass.png", "foliage.png", "bark.png"}) {
+    const std::string bytes = FileBytes(a.world_dir + "/textures/" + texture);
+    EXPECT_FALSE(bytes.empty()) << texture;
+    EXPECT_EQ(bytes, FileBytes(b.world_dir + "/textures/" + texture)) << texture;
+  }
+  // The same foliage meshes (inline in world.xml), once the folder names are the same.
+  std::string world_b = FileBytes(b.world_dir + "/world.xml");
+  for (std::size_t at = world_b.find("look_b"); at != std::string::npos; at = world_b.find("look_b", at)) {
+    world_b.replace(at, 6, "look_a");
+  }
+  EXPECT_EQ(FileBytes(a.world_dir + "/world.xml"), world_b);
+  const garden::Garden lawn = garden::Garden::Load(TestLawn());
+  EXPECT_EQ(lawn.appearance_seed, garden::Garden::Load(TestLawn()).appearance_seed);
+  EXPECT_NE(lawn.appearance_seed, garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml")).appearance_seed);
 }
 
 }  // namespace

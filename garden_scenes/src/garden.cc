@@ -9,6 +9,7 @@
 #include <set>
 
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
 #include "trimbot/common/yaml_reader.h"
 
 namespace trimbot::garden {
@@ -55,6 +56,12 @@ Garden Garden::Load(const std::string& path) {
   Garden garden;
   garden.source = path;
   garden.name = root.String("name");
+  if (root.Has("seed")) {
+    const int seed = root.Integer("seed", 0, 2147483647);
+    garden.appearance_seed = static_cast<std::uint64_t>(seed);
+  } else {
+    garden.appearance_seed = StreamSeed(0, "garden/" + garden.name);
+  }
   const auto size = root.Doubles("size", 2);
   garden.size = {size[0], size[1]};
   if (!(garden.size.x() > 0 && garden.size.y() > 0)) root.Fail("size", "must be positive");
@@ -118,6 +125,7 @@ std::string Garden::ToYaml() const {
     return shape == Shape::kBox ? "box" : shape == Shape::kCylinder ? "cylinder" : "ellipsoid";
   };
   out << "name: " << name << "\n"
+      << "seed: " << appearance_seed << "\n"
       << "size: [" << size.x() << ", " << size.y() << "]\n"
       << "centre: [" << centre.x() << ", " << centre.y() << "]\n"
       << "ground: " << ToString(ground) << "\n"

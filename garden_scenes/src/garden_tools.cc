@@ -114,6 +114,7 @@ Garden GenerateGarden(const GeneratorParameters& p) {
   auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
   Garden garden;
   garden.name = "generated_" + std::to_string(p.seed);
+  garden.appearance_seed = StreamSeed(p.seed, "garden_appearance") >> 33;  // fits the file's 31-bit seed
   garden.size = p.size + Eigen::Vector2d(2.0, 2.0);
   garden.centre = Eigen::Vector2d::Zero();
   const Eigen::Vector2d half = p.size / 2;
@@ -257,9 +258,9 @@ void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const st
   WriteFileAtomically(dir + "/" + name + ".yaml", yaml.str());
 }
 
-void WriteGroundTruthPly(const Garden& garden, std::uint64_t seed, double growth, double points_per_m2,
+void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2,
                          const std::string& path) {
-  Rng rng = MakeRng(seed, "ground_truth_ply");
+  Rng rng = MakeRng(garden.appearance_seed, "ground_truth_ply");
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::ostringstream body;
   body << std::setprecision(6);
@@ -287,10 +288,10 @@ void WriteGroundTruthPly(const Garden& garden, std::uint64_t seed, double growth
   lawn.faces = {{0, 1, 2}, {0, 2, 3}};
   sample_mesh(lawn, Eigen::Matrix4d::Identity(), ObjectClass::kGround, kGroundObjectId);
   for (const auto& object : garden.objects) {
-    sample_mesh(ObjectMesh(object, seed, growth), ObjectPose(object), object.object_class, object.id);
+    sample_mesh(ObjectMesh(object, garden.appearance_seed, growth), ObjectPose(object), object.object_class, object.id);
   }
   std::ostringstream ply;
-  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << seed << " growth " << growth
+  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << garden.appearance_seed << " growth " << growth
       << "\nelement vertex " << count
       << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar class\nproperty ushort object\n"
          "end_header\n"

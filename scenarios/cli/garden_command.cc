@@ -22,7 +22,6 @@ struct GardenOptions {
   double clearance = 1.0;
   double growth = 0.0;
   double point_density = 400.0;
-  std::uint64_t seed = 0;
 };
 
 void Write(const std::string& path, const std::string& text) {
@@ -83,7 +82,6 @@ void AddGardenCommands(CLI::App& app, const std::string& data_root) {
   export_cmd->add_option("--resolution", options->resolution, "occupancy cell size (m)")->check(CLI::PositiveNumber);
   export_cmd->add_option("--clearance", options->clearance,
                          "objects starting higher than this (tree crowns) are not obstacles (m)");
-  export_cmd->add_option("--seed", options->seed, "foliage seed (as the run's seed)");
   export_cmd->add_option("--growth", options->growth, "seasonal growth 0..1")->check(CLI::Range(0.0, 1.0));
   export_cmd->add_option("--points-per-m2", options->point_density, "PLY sampling density");
   export_cmd->callback([options, &data_root] {  // data_root is read after --data-root is parsed
@@ -92,7 +90,7 @@ void AddGardenCommands(CLI::App& app, const std::string& data_root) {
     std::filesystem::create_directories(options->output);
     garden::WriteOccupancyMap(garden::MakeOccupancyMap(garden, options->resolution, options->clearance),
                               options->output, garden.name + "_occupancy");
-    garden::WriteGroundTruthPly(garden, options->seed, options->growth, options->point_density,
+    garden::WriteGroundTruthPly(garden, options->growth, options->point_density,
                                 options->output + "/" + garden.name + "_ground_truth.ply");
     std::printf("wrote %s/%s_occupancy.{png,yaml} and %s_ground_truth.ply\n", options->output.c_str(),
                 garden.name.c_str(), garden.name.c_str());

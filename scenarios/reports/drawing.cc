@@ -14,8 +14,6 @@ std::string FormatNumber(double value) {
   return out.str();
 }
 
-
-
 cv::Scalar HsvToRgb(double hue_deg, double saturation, double value) {
   const double h = std::fmod(std::fmod(hue_deg, 360.0) + 360.0, 360.0) / 60.0;
   const double chroma = value * saturation;

@@ -72,7 +72,6 @@ Simulator::Simulator(const SimulatorConfig& config)
   WorldOptions options;
   options.timestep = config.timestep;
   options.start = config.start;
-  options.seed = config.seed;
   options.conditions = config.conditions;
   options.msaa_samples = config.msaa_samples;
   spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);

@@ -180,12 +180,12 @@ class MjcfEmitter {
   std::vector<std::string> joints_;
 };
 
-std::string WriteTexture(garden::Material material, const WorldOptions& options, const fs::path& dir) {
+std::string WriteTexture(garden::Material material, std::uint64_t seed, const WorldOptions& options, const fs::path& dir) {
   const fs::path path = dir / (garden::ToString(material) + ".png");
   std::vector<uchar> png;
   // Ground tiles cover 2-4 m and are seen from 0.5 m up: they get twice the resolution.
   const int size = garden::TileSize(material) > 1.0 ? 2 * options.texture_size : options.texture_size;
-  cv::imencode(".png", garden::MakeTexture(material, options.seed, size), png);
+  cv::imencode(".png", garden::MakeTexture(material, seed, size), png);
   WriteFileAtomically(path.string(), std::string(png.begin(), png.end()));
   return fs::absolute(path).string();
 }
@@ -222,7 +222,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
             "rgb2=\"0.92 0.95 1.0\" width=\"256\" height=\"256\"/>\n";
   for (const auto material : materials) {
     const std::string name = garden::ToString(material);
-    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << WriteTexture(material, options, texture_dir)
+    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << WriteTexture(material, garden.appearance_seed, options, texture_dir)
            << "\"/>\n"
            << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
   }
@@ -268,7 +268,7 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
   }
   for (const auto& object : garden.objects) {
     const std::string name = "garden/" + std::to_string(object.id) + "_" + garden::ToString(object.object_class);
-    emit_mesh(name, garden::ObjectMesh(object, options.seed, options.conditions.growth), garden::ObjectPose(object),
+    emit_mesh(name, garden::ObjectMesh(object, garden.appearance_seed, options.conditions.growth), garden::ObjectPose(object),
               garden::ToString(garden::MaterialOf(object.object_class)), "garden");
     spec.labels.push_back({name, object.object_class, static_cast<std::uint16_t>(object.id), false, garden.ground});
   }

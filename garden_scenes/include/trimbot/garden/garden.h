@@ -3,6 +3,7 @@
 // files (garden_scenes/gardens/*.yaml); the simulator turns them into MuJoCo geometry. What varies
 // from run to run (time of day, season) is in Conditions, not in the garden.
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ struct Garden {
   Surface ground = Surface::kGrass;
   double latitude = 52.0 * M_PI / 180.0;    // rad (Wageningen by default), for the sun's path
   double north = M_PI / 2;                  // rad, direction of north in the map frame (from +x, CCW)
+  // Seeds the garden's look - textures, leaf clumps, outgrowth - so every run in this garden sees
+  // the same garden (a run's own seed drives only sensor noise, faults and dynamics). The file's
+  // `seed:`, or else one derived from the garden's name.
+  std::uint64_t appearance_seed = 0;
   std::vector<GroundPatch> paths;
   std::vector<GardenObject> objects;
 

@@ -46,9 +46,9 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
 // Writes <dir>/<name>.png and <dir>/<name>.yaml in ROS map_server format.
 void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const std::string& name);
 
-// Samples the garden's surfaces (ground, paths, object meshes as grown under `growth`) into an
-// ASCII PLY point cloud with per-point class and object id.
-void WriteGroundTruthPly(const Garden& garden, std::uint64_t seed, double growth, double points_per_m2,
+// Samples the garden's surfaces (ground, paths, object meshes as grown under `growth`, shaped by the
+// garden's appearance seed) into an ASCII PLY point cloud with per-point class and object id.
+void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2,
                          const std::string& path);
 
 }  // namespace trimbot::garden

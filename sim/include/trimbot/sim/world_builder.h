@@ -20,7 +20,6 @@ struct Pose2D {
 struct WorldOptions {
   double timestep = 0.002;        // s, fixed physics step
   Pose2D start;                   // base_link in the map frame
-  std::uint64_t seed = 0;         // seeds the garden's textures and foliage
   garden::Conditions conditions;  // sun and growth
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;
