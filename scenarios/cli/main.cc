@@ -9,6 +9,7 @@
 #include "cli/drive_command.h"
 #include "cli/fusion_command.h"
 #include "cli/garden_command.h"
+#include "cli/map_command.h"
 #include "cli/registration_command.h"
 #include "cli/stereo_command.h"
 #include "cli/tuning_commands.h"
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   AddRegistrationCommand(app, exit_code);
   AddCompareCommand(app, exit_code);
   AddTuningCommands(app, data_root, exit_code);
+  AddMapCommands(app, data_root, exit_code);
   AddFusionCommand(app, data_root, exit_code);
   AddStereoCommand(app, data_root);
 

@@ -17,7 +17,8 @@ bool RunClosedLoop(sim::Simulator& simulator, Controller& controller, const std:
     fixes.clear();
     simulator.Step(&sensors, &truth);
     const double t = simulator.time();
-    if (options.render_on_demand && truth.ring_exposed && controller.WantsRingFrame(t)) {
+    if (options.render_on_demand && truth.ring_exposed &&
+        (controller.WantsRingFrame(t) || (options.ring_demand && options.ring_demand(truth)))) {
       sim::RingCapture capture = simulator.CaptureRing(false);
       sensors.ring = std::move(capture.frame);
       truth.ring = std::move(capture.truth);

@@ -54,6 +54,9 @@ struct LoopOptions {
   // The simulator renders the ring only when the controller wants a frame (it must have been
   // configured with render_cameras and without cameras_on_schedule).
   bool render_on_demand = false;
+  // Whether an offline consumer beside the controller (e.g. the map builder) wants the ring frame
+  // exposed in this step; with render_on_demand the ring is rendered if either wants it.
+  std::function<bool(const sim::GroundTruth&)> ring_demand;
   SimulatedPoseFixes* pose_fixes = nullptr;  // test fixture, when the stack is configured for it
   std::function<void(double)> progress;    // called about once per simulated second
 };

@@ -1,0 +1,141 @@
+#include "runner/mapping.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <random>
+
+#include "eval/trial_result.h"
+#include "reports/map_plot.h"
+#include "runner/closed_loop.h"
+#include "runner/controllers.h"
+#include "runner/drive_plan.h"
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/random.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/visual_localization/map_builder.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The survey: each exposure's true pose with seeded noise, drawn once per exposure.
+class Survey {
+ public:
+  Survey(std::uint64_t seed, double position_sigma, double rotation_sigma)
+      : rng_(MakeRng(seed, "survey")), position_sigma_(position_sigma), rotation_sigma_(rotation_sigma) {}
+
+  const Eigen::Isometry3d& PoseAt(const sim::GroundTruth& truth) {
+    auto it = poses_.find(truth.stamp);
+    if (it != poses_.end()) return it->second;
+    Eigen::Isometry3d pose = truth.T_map_base;
+    const Eigen::Vector3d dp(normal_(rng_), normal_(rng_), normal_(rng_));
+    const Eigen::Vector3d dr(normal_(rng_), normal_(rng_), normal_(rng_));
+    pose.translation() += position_sigma_ * dp;
+    const Eigen::Vector3d w = rotation_sigma_ * dr;
+    if (w.norm() > 0.0) pose.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * pose.linear();
+    truth_[truth.stamp] = truth.T_map_base;
+    return poses_.emplace(truth.stamp, pose).first->second;
+  }
+  const std::map<double, Eigen::Isometry3d>& truth() const { return truth_; }
+  const std::map<double, Eigen::Isometry3d>& poses() const { return poses_; }
+
+ private:
+  Rng rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  double position_sigma_, rotation_sigma_;
+  std::map<double, Eigen::Isometry3d> poses_, truth_;
+};
+
+// Hands the rendered keyframes to the builder with their survey poses.
+class MapRecorder : public Observer {
+ public:
+  MapRecorder(visual_localization::MapBuilder& builder, Survey& survey) : builder_(builder), survey_(survey) {}
+  void Observe(const StepView& step) override {
+    if (step.sensors.ring) builder_.AddFrame(*step.sensors.ring, survey_.PoseAt(step.truth));
+  }
+
+ private:
+  visual_localization::MapBuilder& builder_;
+  Survey& survey_;
+};
+
+// Mean position error (m) of the map's keyframes against the ground truth at their stamps.
+nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const Survey& survey) {
+  std::vector<double> adjusted, surveyed;
+  for (const auto& k : map.keyframes) {
+    const auto truth = survey.truth().find(k.stamp);
+    if (truth == survey.truth().end()) continue;
+    adjusted.push_back((k.T_map_base.translation() - truth->second.translation()).norm());
+    surveyed.push_back((survey.poses().at(k.stamp).translation() - truth->second.translation()).norm());
+  }
+  return {{"survey_position_error_mean_m", ErrorStats::From(surveyed).mean},
+          {"adjusted_position_error_mean_m", ErrorStats::From(adjusted).mean}};
+}
+
+}  // namespace
+
+int RunMapBuild(const MapBuildOptions& options) {
+  const auto wall_start = Clock::now();
+  const DrivePlan plan = DrivePlan::Load(options.plan_path);
+  WorldSetup world = plan.world;
+  if (options.seed) world.seed = *options.seed;
+  std::filesystem::create_directories(options.out_dir);
+  sim::SimulatorConfig config = MakeSimulatorConfig(options.paths, world, options.out_dir + "/world");
+  config.cameras_on_schedule = false;  // only the keyframes are rendered
+  sim::Simulator simulator(config);
+
+  // The map is made with the calibration the robot's stack reads (robot/), as the real one was.
+  const robot::RobotFiles files = options.paths.robot_files();
+  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
+  const robot::CameraRig rig =
+      robot::CameraRig::LoadKalibr(files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
+  visual_localization::MapBuilderOptions builder_options;
+  builder_options.survey_position_sigma = options.survey_position_sigma;
+  builder_options.survey_rotation_sigma = options.survey_rotation_sigma_deg * M_PI / 180.0;
+  visual_localization::MapBuilder builder(rig, builder_options);
+  Survey survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
+
+  const double duration = std::min(plan.duration(), options.seconds.value_or(plan.duration()));
+  DrivePlanPlayer player(plan, duration);
+  MapRecorder recorder(builder, survey);
+  LoopOptions loop;
+  loop.time_limit = duration;
+  loop.render_on_demand = true;
+  loop.ring_demand = [&](const sim::GroundTruth& truth) { return builder.WantsFrame(survey.PoseAt(truth)); };
+  std::cout << "[map] driving " << options.plan_path << " (" << duration << " s), rendering keyframes" << std::endl;
+  RunClosedLoop(simulator, player, {&recorder}, loop);
+  const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+
+  visual_localization::MapBuildStats stats;
+  const visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
+  map.Save(options.out_dir + "/map.sqlite");
+  const garden::OccupancyMap objects = garden::MakeOccupancyMap(simulator.garden(), 0.05, 1.0);
+  WriteMapTopView(options.out_dir + "/map_top_view.png", map, objects,
+                  "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
+                      std::to_string(stats.keyframes) + " keyframes");
+  const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  nlohmann::json report = {{"plan", options.plan_path}, {"garden", map.garden}, {"seed", world.seed},
+                           {"frames_seen", stats.frames}, {"keyframes", stats.keyframes},
+                           {"images_matched", stats.images_matched}, {"matches", stats.matches},
+                           {"tracks", stats.tracks}, {"points", stats.points}, {"observations", stats.observations},
+                           {"mean_track_length", stats.mean_track_length},
+                           {"reprojection_rmse_px", stats.reprojection_rmse_px},
+                           {"seconds", {{"drive_and_render", drive_seconds - stats.seconds_features},
+                                        {"features", stats.seconds_features}, {"matching", stats.seconds_matching},
+                                        {"adjustment", stats.seconds_adjustment}, {"vocabulary", stats.seconds_vocabulary},
+                                        {"total", total_seconds}}},
+                           {"keyframes_against_ground_truth", KeyframeErrors(map, survey)}};
+  WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
+  std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "
+            << stats.mean_track_length << ", reprojection RMSE " << stats.reprojection_rmse_px << " px, "
+            << total_seconds << " s -> " << options.out_dir << "/map.sqlite" << std::endl;
+  return 0;
+}
+
+}  // namespace trimbot::scenarios

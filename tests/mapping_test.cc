@@ -1,0 +1,109 @@
+// Visual maps: the file round-trips, bad or foreign files are refused with the file named, and a
+// short mapping drive gives a consistent map.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "runner/mapping.h"
+#include "test_support.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/visual_localization/visual_map.h"
+
+namespace trimbot::visual_localization {
+namespace {
+
+VisualMap SmallMap() {
+  VisualMap map;
+  map.garden = "test_lawn";
+  map.rig_signature = "0123456789abcdef";
+  for (int k = 0; k < 3; ++k) {
+    MapKeyframe keyframe;
+    keyframe.id = k;
+    keyframe.stamp = 0.2 * k;
+    keyframe.T_map_base.translation() << 0.3 * k, -0.1, 0.0;
+    keyframe.T_map_base.linear() = Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    map.keyframes.push_back(keyframe);
+  }
+  map.descriptors = cv::Mat(5, 128, CV_32F);
+  cv::randu(map.descriptors, 0.0, 200.0);
+  for (int i = 0; i < 5; ++i) {
+    map.points.emplace_back(i, 2.0 * i, 0.5);
+    map.observations.push_back({i % 3, i, i, Eigen::Vector2d(100.5 + i, 200.25)});
+  }
+  map.vocabulary = map.descriptors.rowRange(0, 2).clone();
+  return map;
+}
+
+TEST(VisualMap, RoundTripsThroughItsFile) {
+  const VisualMap map = SmallMap();
+  const std::string path = testing::TempDir("visual_map") + "/map.sqlite";
+  map.Save(path);
+  const VisualMap read = VisualMap::Load(path, "test_lawn", "0123456789abcdef");
+  ASSERT_EQ(read.keyframes.size(), 3u);
+  EXPECT_TRUE(read.keyframes[2].T_map_base.isApprox(map.keyframes[2].T_map_base, 1e-12));
+  EXPECT_EQ(read.keyframes[1].stamp, 0.2);
+  ASSERT_EQ(read.points.size(), 5u);
+  EXPECT_EQ(read.points[4], map.points[4]);
+  EXPECT_EQ(cv::norm(read.descriptors, map.descriptors, cv::NORM_INF), 0.0);
+  ASSERT_EQ(read.observations.size(), 5u);
+  EXPECT_EQ(read.observations[3].pixel, map.observations[3].pixel);
+  EXPECT_EQ(read.observations[3].camera, 3);
+  EXPECT_EQ(cv::norm(read.vocabulary, map.vocabulary, cv::NORM_INF), 0.0);
+}
+
+TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
+  const std::string dir = testing::TempDir("visual_map_bad");
+  const std::string good = dir + "/good.sqlite";
+  SmallMap().Save(good);
+  const auto message = [](const std::function<void()>& load) {
+    try {
+      load();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message([&] { VisualMap::Load(good, "wageningen"); }).find("made in garden 'test_lawn'"), std::string::npos);
+  EXPECT_NE(message([&] { VisualMap::Load(good, "", "ffffffffffffffff"); }).find("another camera rig"), std::string::npos);
+  const std::string garbage = testing::WriteTempFile("garbage.sqlite", "this is not a database at all");
+  EXPECT_NE(message([&] { VisualMap::Load(garbage); }).find(garbage), std::string::npos);
+  // Truncated: half of a real map file.
+  std::ifstream in(good, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string truncated = dir + "/truncated.sqlite";
+  std::ofstream(truncated, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_NE(message([&] { VisualMap::Load(truncated); }).find("truncated.sqlite"), std::string::npos);
+  EXPECT_NE(message([&] { VisualMap::Load(dir + "/missing.sqlite"); }).find("not found"), std::string::npos);
+}
+
+TEST(MapBuild, AShortDriveGivesAConsistentMap) {
+  scenarios::MapBuildOptions options;
+  options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.out_dir = testing::TempDir("map_build");
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  options.seconds = 6.0;
+  ASSERT_EQ(scenarios::RunMapBuild(options), 0);
+  std::ifstream in(options.out_dir + "/map_stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  EXPECT_GE(stats["keyframes"].get<int>(), 4);
+  EXPECT_GT(stats["points"].get<int>(), 200);
+  EXPECT_GT(stats["mean_track_length"].get<double>(), 2.0);
+  EXPECT_LT(stats["reprojection_rmse_px"].get<double>(), 3.0);
+  const auto& errors = stats["keyframes_against_ground_truth"];
+  EXPECT_LT(errors["adjusted_position_error_mean_m"].get<double>(), errors["survey_position_error_mean_m"].get<double>())
+      << "bundle adjustment brings the keyframes closer to the truth than the survey";
+  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
+  const robot::CameraRig rig = robot::CameraRig::LoadKalibr(
+      files.camchain, robot::RobotDescription::Load(files.urdf).FramePose(robot::RobotFrames::CameraOptical(0)));
+  const VisualMap map = VisualMap::Load(options.out_dir + "/map.sqlite", "test_lawn", RigSignature(rig));
+  EXPECT_EQ(static_cast<int>(map.points.size()), stats["points"].get<int>());
+  EXPECT_GT(map.vocabulary.rows, 10);
+  EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/map_top_view.png"));
+}
+
+}  // namespace
+}  // namespace trimbot::visual_localization
