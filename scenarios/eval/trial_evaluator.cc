@@ -50,7 +50,10 @@ void TrialEvaluator::Observe(const StepView& step) {
   while (truth_history_.size() > 2 && truth_history_.front().t < truth.t - fix_history_seconds_) {
     truth_history_.pop_front();
   }
-  for (const auto& fix : step.pose_fixes) {
+  // Fixes of the simulated fixture, and the stack's own visual fixes as they reach its EKF.
+  std::vector<messages::PoseFix> fixes = step.pose_fixes;
+  if (step.telemetry != nullptr) fixes.insert(fixes.end(), step.telemetry->visual_fixes.begin(), step.telemetry->visual_fixes.end());
+  for (const auto& fix : fixes) {
     fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
     if (const PlanarPose* at = TruthAt(fix.stamp)) AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
   }

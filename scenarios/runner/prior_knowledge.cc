@@ -104,6 +104,10 @@ stack::StackParameters StackParametersFor(const Scenario& scenario, const Projec
                                           stack::ToString(parameters.localization) +
                                           "' (set stack: {localization: simulated_pose_fixes} to use them)");
   }
+  if (parameters.localization == stack::LocalizationSource::kVisual && scenario.visual_map.empty()) {
+    throw InputError(scenario.source, "the stack's localization is 'visual', but the scenario names no visual_map "
+                                      "(build one with `trimbot map build`)");
+  }
   return parameters;
 }
 

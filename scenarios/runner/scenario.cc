@@ -1,6 +1,7 @@
 #include "runner/scenario.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -107,6 +108,10 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     sigma.RejectUnknownKeys();
   }
   if (root.Has("calibration_error")) s.calibration_error = ReadCalibrationError(root.Map("calibration_error"));
+  if (root.Has("visual_map")) {
+    const std::filesystem::path map = root.String("visual_map");
+    s.visual_map = (map.is_absolute() ? map : std::filesystem::path(s.source).parent_path() / map).string();
+  }
 }
 
 void ReadPlant(const YamlMap& root, Scenario& s) {

@@ -56,6 +56,7 @@ struct Scenario {
   double initial_position_sigma = 0.1; // m per axis: the stack's start belief = truth + this noise
   double initial_yaw_sigma = 3.0 * M_PI / 180.0;  // rad
   CalibrationError calibration_error;
+  std::string visual_map;              // map file for localization: visual (relative to this file)
   int trials = 1;
   double time_limit = 300.0;           // s of simulated time per trial
   double wall_time_limit = 1800.0;     // s of wall-clock time per trial before it is killed

@@ -1,5 +1,6 @@
 #include "runner/trial.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <optional>
@@ -21,7 +22,8 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup) {
   WorldSetup world = scenario.world;
   world.seed = setup.seed;
   sim::SimulatorConfig config = MakeSimulatorConfig(setup.paths, world, setup.dir + "/world");
-  config.render_cameras = scenario.render_cameras;
+  config.render_cameras = scenario.render_cameras || setup.render_for_stack;
+  config.cameras_on_schedule = !setup.render_for_stack;  // the stack asks for the frames it uses
   config.resolution_scale = scenario.resolution_scale;
   config.faults = scenario.faults;
   config.imu_noise_scale = scenario.imu_noise_scale;
@@ -30,10 +32,15 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup) {
 }
 
 void WriteTiming(const std::string& dir, double wall_seconds, double simulated_seconds, const stack::StackTimings& t) {
-  const nlohmann::json timing = {{"wall_seconds", wall_seconds},
-                                 {"real_time_factor", wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0},
-                                 {"stack_seconds",
-                                  {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}}};
+  const double frames = std::max(1, t.visual_frames);
+  const nlohmann::json timing = {
+      {"wall_seconds", wall_seconds},
+      {"real_time_factor", wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0},
+      {"stack_seconds", {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}},
+      {"visual_localization_ms_per_frame",
+       {{"frames", t.visual_frames}, {"features", 1000 * t.visual_features / frames},
+        {"retrieval", 1000 * t.visual_retrieval / frames}, {"matching", 1000 * t.visual_matching / frames},
+        {"pose", 1000 * t.visual_pose / frames}}}};
   WriteFileAtomically(dir + "/timing.json", timing.dump(2));
 }
 
@@ -48,26 +55,31 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   result.seed = setup.seed;
   for (const auto& fault : scenario.faults) result.faults.push_back(fault.Describe());
 
-  sim::Simulator simulator(PlantFor(setup));
-
   // The robot's side, from its own files and what the operator knows; never from the simulator.
   robot::RobotFiles files = setup.paths.robot_files();
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
   const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
+  const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
+  TrialSetup plant_setup = setup;
+  plant_setup.render_for_stack = visual;
+  sim::Simulator simulator(PlantFor(plant_setup));
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
   robot.SetMap(setup.map_yaml);
+  if (visual) robot.SetVisualMap(scenario.visual_map);
   robot.SetGoals(scenario.goals);
 
   std::optional<SimulatedPoseFixes> fixes;
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     fixes.emplace(scenario.simulated_pose_fixes, setup.seed);
   }
-  TrialEvaluator evaluator(scenario.goals, scenario.goal_tolerance, scenario.simulated_pose_fixes.latency_max + 1.0);
+  TrialEvaluator evaluator(scenario.goals, scenario.goal_tolerance,
+                           std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
   StackController controller(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;
   options.pose_fixes = fixes ? &*fixes : nullptr;
+  options.render_on_demand = visual;
   options.progress = progress;
   const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);
 

@@ -2,6 +2,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <random>
+
+#include <Eigen/Eigenvalues>
 
 #include "trimbot/common/input_error.h"
 #include "trimbot/robot/camera_rig.h"
@@ -12,6 +15,8 @@
 #include "trimbot/stack/navigator.h"
 #include "trimbot/stack/occupancy_grid.h"
 #include "trimbot/stack/wheel_odometry.h"
+#include "trimbot/common/random.h"
+#include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::stack {
 namespace {
@@ -62,6 +67,8 @@ struct RobotStack::Components {
   std::unique_ptr<OccupancyGrid> map;
   std::unique_ptr<Navigator> navigator;
   std::unique_ptr<perception::LocalFusion> fusion;
+  std::unique_ptr<visual_localization::VisualLocalizer> localizer;
+  Rng latency_rng;
 
   Components(const robot::RobotFiles& files, const StackParameters& parameters)
       : description(robot::RobotDescription::Load(files.urdf)),
@@ -69,7 +76,8 @@ struct RobotStack::Components {
                                          description.FramePose(robot::RobotFrames::CameraOptical(0)))),
         ticks_per_revolution(robot::RobotParameters::Load(files.robot_parameters).wheel_encoders.ticks_per_revolution),
         odometry(description.drive(), ticks_per_revolution),
-        ekf(parameters.ekf, description.drive(), ticks_per_revolution) {
+        ekf(parameters.ekf, description.drive(), ticks_per_revolution),
+        latency_rng(0) {
     if (parameters.local_fusion.enabled) fusion = std::make_unique<perception::LocalFusion>(rig, parameters.local_fusion);
   }
 };
@@ -77,6 +85,8 @@ struct RobotStack::Components {
 RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed)
     : parameters_(parameters), components_(std::make_unique<Components>(files, parameters)) {
   SeedPlanner(seed);
+  seed_ = seed;
+  components_->latency_rng = MakeRng(seed, "visual_localization_latency");
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
 
@@ -94,6 +104,18 @@ void RobotStack::SetMap(const std::string& map_yaml) {
   components_->navigator.reset();
   components_->map = std::make_unique<OccupancyGrid>(OccupancyGrid::LoadMapServer(map_yaml));
   components_->navigator = std::make_unique<Navigator>(*components_->map, parameters_.navigation);
+}
+
+void RobotStack::SetVisualMap(const std::string& map_path) {
+  const VisualLocalizationParameters& v = parameters_.visual;
+  visual_localization::LocalizerOptions options;
+  options.features.max_features = v.features;
+  options.keyframes = v.keyframes;
+  options.prior_radius = v.prior_radius;
+  options.pose.min_inliers = v.min_inliers;
+  components_->localizer = std::make_unique<visual_localization::VisualLocalizer>(
+      visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(components_->rig)),
+      components_->rig, options);
 }
 
 void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
@@ -121,6 +143,10 @@ void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
 
 void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
+  if (parameters_.localization == LocalizationSource::kVisual && components_->localizer &&
+      frame.stamp + 1e-9 >= next_localization_ && frame.stamp >= localizer_busy_until_) {
+    LocalizeVisually(frame);
+  }
   if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
     ScopedTimer timer(&telemetry_.timings.perception);
     // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
@@ -138,7 +164,65 @@ void RobotStack::Add(const messages::PoseFix& fix) {
 }
 
 bool RobotStack::WantsRingFrame(double stamp) const {
-  return components_->fusion != nullptr && components_->fusion->Wants(stamp);
+  const bool localization = parameters_.localization == LocalizationSource::kVisual && components_->localizer &&
+                            stamp + 1e-9 >= next_localization_ && stamp >= localizer_busy_until_;
+  return localization || (components_->fusion != nullptr && components_->fusion->Wants(stamp));
+}
+
+void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
+  ScopedTimer timer(&telemetry_.timings.localization);
+  Components& c = *components_;
+  std::optional<Eigen::Vector2d> prior;
+  if (c.ekf.initialized()) prior = Eigen::Vector2d(c.ekf.Estimate().pose.x, c.ekf.Estimate().pose.y);
+  const auto start = std::chrono::steady_clock::now();
+  const visual_localization::LocalizationResult result = c.localizer->Localize(frame, prior);
+  const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const VisualLocalizationParameters& v = parameters_.visual;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double drawn = std::min(v.latency_max, v.latency_median * std::exp(v.latency_log_sigma * normal(c.latency_rng)));
+  const double latency = v.measured_latency ? measured : drawn;
+  localizer_busy_until_ = frame.stamp + latency;  // one frame at a time
+  next_localization_ = frame.stamp + 1.0 / v.rate_hz;
+  ++telemetry_.visual.attempts;
+  StackTimings& t = telemetry_.timings;
+  t.visual_features += result.timings.features;
+  t.visual_retrieval += result.timings.retrieval;
+  t.visual_matching += result.timings.matching;
+  t.visual_pose += result.timings.pose;
+  ++t.visual_frames;
+  if (!result.success) {
+    ++telemetry_.visual.failures;
+    return;
+  }
+  ++telemetry_.visual.fixes;
+  messages::PoseFix fix;
+  fix.stamp = frame.stamp;
+  const Pose2 planar = ToPose2(result.T_map_base);
+  fix.x = planar.x;
+  fix.y = planar.y;
+  fix.yaw = planar.yaw;
+  fix.covariance = result.planar_covariance;
+  pending_fixes_.push_back({frame.stamp + latency, fix});
+}
+
+void RobotStack::DeliverVisualFixes(double stamp) {
+  telemetry_.visual_fixes.clear();
+  for (auto it = pending_fixes_.begin(); it != pending_fixes_.end();) {
+    if (it->ready > stamp + 1e-12) {
+      ++it;
+      continue;
+    }
+    components_->ekf.AddPoseFix(it->fix);
+    telemetry_.visual_fixes.push_back(it->fix);
+    it = pending_fixes_.erase(it);
+  }
+}
+
+bool RobotStack::LocalizationLost() const {
+  if (parameters_.localization != LocalizationSource::kVisual) return false;
+  const Eigen::Matrix2d position = components_->ekf.Estimate().covariance.topLeftCorner<2, 2>();
+  const double sigma = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(position).eigenvalues().maxCoeff());
+  return sigma > parameters_.visual.max_position_sigma;
 }
 
 messages::RobotCommands RobotStack::Update(double stamp) {
@@ -147,6 +231,7 @@ messages::RobotCommands RobotStack::Update(double stamp) {
   telemetry_.events.clear();
   telemetry_.registration = std::move(pending_registration_);
   pending_registration_.reset();
+  DeliverVisualFixes(stamp);
   if (stamp + 1e-9 >= next_control_) {
     // Control ticks at whole multiples of the period (no drift from summing periods).
     next_control_ = (std::floor((stamp + 1e-9) * parameters_.control_rate_hz) + 1.0) / parameters_.control_rate_hz;
@@ -167,6 +252,12 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   Navigator* navigator = components_->navigator.get();
   if (navigator == nullptr) return;
   ScopedTimer timer(&telemetry_.timings.navigation);
+  if (LocalizationLost()) {
+    // Better to stand than to drive blind: wait for the localization to come back.
+    commands->base = messages::BaseVelocityCommand{};
+    ++telemetry_.visual.stopped_updates;
+    return;
+  }
   commands->base = navigator->Update(stamp, components_->ekf.Estimate().pose);
   telemetry_.events = navigator->TakeEvents();
   telemetry_.mission = ToMission(navigator->mode());

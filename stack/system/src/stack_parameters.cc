@@ -59,6 +59,24 @@ void ReadEkf(Reader& r, EkfParameters& p) {
   r.Number("max_fix_lead", &p.max_fix_lead, 0.0, 10.0, "s");
 }
 
+void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
+  r.Number("rate_hz", &p.rate_hz, 0.01, 100.0, "Hz");
+  if (r.Wanted("latency")) {
+    const std::string mode = r.map().String("latency");
+    if (mode != "deterministic" && mode != "measured") r.map().Fail("latency", "must be deterministic or measured");
+    p.measured_latency = mode == "measured";
+  }
+  r.Number("latency_median", &p.latency_median, 1e-3, 60.0, "s");
+  r.Number("latency_log_sigma", &p.latency_log_sigma, 0.0, 10.0);
+  r.Number("latency_max", &p.latency_max, 1e-3, 60.0, "s");
+  r.Integer("features", &p.features, 50, 100000);
+  r.Integer("keyframes", &p.keyframes, 1, 1000);
+  r.Number("prior_radius", &p.prior_radius, 0.1, 1000.0, "m");
+  r.Integer("min_inliers", &p.min_inliers, 4, 100000);
+  r.Number("max_position_sigma", &p.max_position_sigma, 0.01, 1000.0, "m");
+  if (p.latency_max < p.latency_median) r.map().Fail("latency_max", "must be at least latency_median");
+}
+
 void ReadFootprint(Reader& r, Footprint& p) {
   if (r.Wanted("circle_x")) {
     p.circle_x = r.map().Doubles("circle_x");
@@ -118,8 +136,10 @@ void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
     *source = LocalizationSource::kNone;
   } else if (name == "simulated_pose_fixes") {
     *source = LocalizationSource::kSimulatedPoseFixes;
+  } else if (name == "visual") {
+    *source = LocalizationSource::kVisual;
   } else {
-    map.Fail("localization", "unknown source '" + name + "' (none, simulated_pose_fixes)");
+    map.Fail("localization", "unknown source '" + name + "' (none, visual, simulated_pose_fixes)");
   }
 }
 
@@ -130,6 +150,7 @@ void Read(Reader& r, StackParameters& s) {
     f.Degrees("yaw_deg", &s.initial_yaw_sigma, 0.01, 180.0);
   });
   r.Section("ekf", [&](Reader& f) { ReadEkf(f, s.ekf); });
+  r.Section("visual_localization", [&](Reader& f) { ReadVisual(f, s.visual); });
   r.Section("navigation", [&](Reader& f) { ReadNavigation(f, s); });
   r.Section("perception", [&](Reader& perception) {
     perception.Section("local_fusion", [&](Reader& f) {
@@ -148,6 +169,7 @@ const char* ToString(LocalizationSource source) {
   switch (source) {
     case LocalizationSource::kNone: return "none";
     case LocalizationSource::kSimulatedPoseFixes: return "simulated_pose_fixes";
+    case LocalizationSource::kVisual: return "visual";
   }
   return "?";
 }

@@ -32,6 +32,17 @@ struct StackTimings {
   double localization = 0.0;
   double navigation = 0.0;
   double perception = 0.0;
+  // Visual localization by stage (features, retrieval, matching, pose), and how many frames.
+  double visual_features = 0.0, visual_retrieval = 0.0, visual_matching = 0.0, visual_pose = 0.0;
+  int visual_frames = 0;
+};
+
+// The stack's own visual localization, counted.
+struct VisualLocalizationCounters {
+  int attempts = 0;       // ring frames localized
+  int fixes = 0;          // of which gave a pose
+  int failures = 0;       // no pose (too few features, matches or inliers)
+  int stopped_updates = 0;  // control updates the robot stood still for lack of localization
 };
 
 // What the stack reports after an update, for logs and evaluation.
@@ -46,6 +57,8 @@ struct Telemetry {
   int ring_frames = 0;                   // received
   int pose_fixes_ignored = 0;            // received while no fix source is configured
   std::optional<perception::CloudRegistration> registration;  // local fusion, in the last update
+  std::vector<messages::PoseFix> visual_fixes;  // the stack's own fixes applied in the last update
+  VisualLocalizationCounters visual;
   StackTimings timings;
 };
 
@@ -64,6 +77,9 @@ class RobotStack {
   void SetInitialPose(double stamp, const Pose2& believed_pose);
   // The prior map of the garden (map_server YAML + PNG); needed before goals.
   void SetMap(const std::string& map_yaml);
+  // The visual localization map (trimbot map build); needed with localization: visual. Throws
+  // InputError naming the file if it is not a map or was made for another camera rig.
+  void SetVisualMap(const std::string& map_path);
   // Goals in the map frame, visited in order; navigation starts with the next update.
   void SetGoals(const std::vector<Eigen::Vector2d>& goals);
   // Drive by hand: the command passes through to the base (navigation stays idle); the stack
@@ -88,6 +104,9 @@ class RobotStack {
 
  private:
   void RunNavigation(double stamp, messages::RobotCommands* commands);
+  void LocalizeVisually(const messages::RingFrame& frame);
+  void DeliverVisualFixes(double stamp);
+  bool LocalizationLost() const;
 
   StackParameters parameters_;
   struct Components;
@@ -96,6 +115,14 @@ class RobotStack {
   double next_control_ = 0.0;
   std::optional<messages::BaseVelocityCommand> teleop_;
   std::optional<perception::CloudRegistration> pending_registration_;  // reported by the next update
+  struct PendingFix {
+    double ready = 0.0;
+    messages::PoseFix fix;
+  };
+  std::vector<PendingFix> pending_fixes_;   // visual fixes still "being computed"
+  double localizer_busy_until_ = -1.0;
+  double next_localization_ = 0.0;
+  std::uint64_t seed_ = 0;
 };
 
 }  // namespace trimbot::stack

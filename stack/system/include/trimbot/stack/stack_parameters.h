@@ -15,6 +15,20 @@ namespace trimbot::stack {
 enum class LocalizationSource {
   kNone,                 // EKF of wheel odometry and gyro only
   kSimulatedPoseFixes,   // PoseFix messages from a test fixture outside the stack
+  kVisual,               // the stack's own visual localization against a pre-built map
+};
+
+struct VisualLocalizationParameters {
+  double rate_hz = 2.0;              // frames localized per second at most
+  bool measured_latency = false;     // fixes reach the EKF after the measured processing time, or
+  double latency_median = 0.15;      // ... (deterministic mode) after a seeded log-normal latency
+  double latency_log_sigma = 0.35;   //     like the real pipeline's (Figure 10 of D3.4)
+  double latency_max = 1.5;          // s
+  int features = 1000;               // Upright-SIFT keypoints per camera image
+  int keyframes = 5;                 // retrieved keyframes whose points are matched
+  double prior_radius = 3.0;         // m around the EKF's position
+  int min_inliers = 12;
+  double max_position_sigma = 0.5;   // m: with a larger EKF uncertainty the robot stops
 };
 const char* ToString(LocalizationSource source);
 
@@ -26,6 +40,7 @@ struct StackParameters {
   double control_rate_hz = 20.0;
   NavigatorParameters navigation;
   perception::LocalFusionOptions local_fusion;
+  VisualLocalizationParameters visual;
 
   // Reads a complete parameter file. Throws InputError naming the file, line and key.
   static StackParameters Load(const std::string& path);
