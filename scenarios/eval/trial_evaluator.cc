@@ -54,6 +54,7 @@ void TrialEvaluator::Observe(const StepView& step) {
   std::vector<messages::PoseFix> fixes = step.pose_fixes;
   if (step.telemetry != nullptr) fixes.insert(fixes.end(), step.telemetry->visual_fixes.begin(), step.telemetry->visual_fixes.end());
   for (const auto& fix : fixes) {
+    fix_stamps_.push_back(fix.stamp);
     fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
     if (const PlanarPose* at = TruthAt(fix.stamp)) AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
   }
@@ -81,6 +82,7 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   const stack::Pose2& estimate = step.telemetry->estimate.pose;
   const stack::Pose2& odometry = step.telemetry->odometry;
+  sample_times_.push_back(step.time);
   AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
   AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);
   truth_tum_ += Tum(truth.t, {truth.x, truth.y, truth.yaw});
@@ -131,11 +133,26 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   result->fixes_rejected = telemetry.localization.fixes_rejected;
   result->relocalizations = telemetry.localization.relocalizations;
   result->estimates = {ekf_, odometry_, fixes_};
+  result->localization_rate = LocalizationRate();
   const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
   result->success = result->status == "completed" && all_reached && collisions_ == 0;
   if (result->status == "completed" && !result->success) {
     result->message = !all_reached ? "a goal was declared reached outside the tolerance" : "collided with the garden";
   }
+}
+
+double TrialEvaluator::LocalizationRate() const {
+  if (fix_stamps_.empty()) return -1.0;
+  std::vector<double> stamps = fix_stamps_;
+  std::sort(stamps.begin(), stamps.end());
+  int counted = 0, covered = 0;
+  for (double t : sample_times_) {
+    if (t < stamps.front()) continue;
+    ++counted;
+    const auto next = std::lower_bound(stamps.begin(), stamps.end(), t - 0.5);
+    if (next != stamps.end() && *next <= t + 0.5) ++covered;
+  }
+  return counted > 0 ? static_cast<double>(covered) / counted : -1.0;
 }
 
 void TrialEvaluator::WriteFiles(const std::string& dir) const {

@@ -36,6 +36,7 @@ class TrialEvaluator : public Observer {
   void ObserveEvents(const StepView& step, const PlanarPose& truth);
   void ObserveContacts(const StepView& step);
   void Sample(const StepView& step, const PlanarPose& truth);
+  double LocalizationRate() const;
 
   double goal_tolerance_;
   double fix_history_seconds_;
@@ -52,6 +53,7 @@ class TrialEvaluator : public Observer {
   double contact_seconds_ = 0.0;
   int plans_ = 0, recoveries_ = 0;
   std::vector<bool> goal_planned_;
+  std::vector<double> sample_times_, fix_stamps_;  // for the localization rate
   long steps_ = 0;
   double timestep_ = 0.0;
 };

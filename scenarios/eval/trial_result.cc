@@ -75,6 +75,7 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"fixes_accepted", t.fixes_accepted},
        {"fixes_rejected", t.fixes_rejected},
        {"relocalizations", t.relocalizations},
+       {"localization_rate", t.localization_rate},
        {"faults", t.faults},
        {"estimates", t.estimates}};
 }
@@ -95,6 +96,7 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   j.at("fixes_accepted").get_to(t.fixes_accepted);
   j.at("fixes_rejected").get_to(t.fixes_rejected);
   j.at("relocalizations").get_to(t.relocalizations);
+  t.localization_rate = j.value("localization_rate", -1.0);
   j.at("faults").get_to(t.faults);
   j.at("estimates").get_to(t.estimates);
 }
@@ -125,6 +127,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   int successes = 0, completed = 0, collisions = 0, recoveries = 0, goals_reached = 0;
   int goals_per_trial = 0;
   double simulated_seconds = 0.0, path_length_m = 0.0;
+  std::vector<double> localization_rates;
   std::vector<std::string> estimate_names;  // in order of first appearance
   std::map<std::string, std::vector<double>> pooled_position_m, pooled_heading_deg;
   for (const TrialResult& trial : trials) {
@@ -137,6 +140,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
         std::count_if(trial.goals.begin(), trial.goals.end(), [](const GoalResult& g) { return g.reached; }));
     simulated_seconds += trial.simulated_seconds;
     path_length_m += trial.path_length_m;
+    if (trial.localization_rate >= 0.0) localization_rates.push_back(trial.localization_rate);
     for (const EstimateErrors& estimate : trial.estimates) {
       if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
       auto& position = pooled_position_m[estimate.name];
@@ -156,6 +160,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   metrics["recoveries"] = recoveries;
   metrics["mean_trial_seconds"] = ratio(simulated_seconds, ran);
   metrics["mean_path_length_m"] = ratio(path_length_m, ran);
+  if (!localization_rates.empty()) metrics["localization_rate"] = ErrorStats::From(localization_rates).mean;
   for (const std::string& name : estimate_names) {
     // An estimate without samples (e.g. no pose fix arrived) has no error metrics, so a criterion
     // on it fails as "not measured" instead of passing with 0.

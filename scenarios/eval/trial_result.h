@@ -48,6 +48,9 @@ struct TrialResult {
   int replans = 0;
   int recoveries = 0;              // obstacle stops followed by a recovery manoeuvre
   int fixes_accepted = 0, fixes_rejected = 0, relocalizations = 0;
+  // Share of the 10 Hz evaluation samples, from the first pose fix on, with a fix stamped within
+  // 0.5 s (Table 2's last column of D3.4); -1 when no fix arrived.
+  double localization_rate = -1.0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
 };
@@ -86,7 +89,7 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 
 // Batch metrics from the trials: success_rate (trials with success / trials planned; a trial that
 // never ran counts as failed), goal_success_rate, trials_completed, collisions, recoveries,
-// mean_trial_seconds (simulated), mean_path_length_m, and per estimate E
+// mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), and per estimate E
 // (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
 // E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples).
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);

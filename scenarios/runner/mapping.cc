@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <random>
 
 #include "eval/trial_result.h"
@@ -13,6 +15,11 @@
 #include "runner/closed_loop.h"
 #include "runner/controllers.h"
 #include "runner/drive_plan.h"
+#include "runner/prior_knowledge.h"
+#include "runner/scenario.h"
+#include "eval/simulated_pose_fixes.h"
+#include "trimbot/common/yaml_reader.h"
+#include "trimbot/stack/robot_stack.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/random.h"
 #include "trimbot/garden/garden_tools.h"
@@ -25,9 +32,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The survey: each exposure's true pose with seeded noise, drawn once per exposure.
-class Survey {
+class SurveyPoses {
  public:
-  Survey(std::uint64_t seed, double position_sigma, double rotation_sigma)
+  SurveyPoses(std::uint64_t seed, double position_sigma, double rotation_sigma)
       : rng_(MakeRng(seed, "survey")), position_sigma_(position_sigma), rotation_sigma_(rotation_sigma) {}
 
   const Eigen::Isometry3d& PoseAt(const sim::GroundTruth& truth) {
@@ -55,18 +62,18 @@ class Survey {
 // Hands the rendered keyframes to the builder with their survey poses.
 class MapRecorder : public Observer {
  public:
-  MapRecorder(visual_localization::MapBuilder& builder, Survey& survey) : builder_(builder), survey_(survey) {}
+  MapRecorder(visual_localization::MapBuilder& builder, SurveyPoses& survey) : builder_(builder), survey_(survey) {}
   void Observe(const StepView& step) override {
     if (step.sensors.ring) builder_.AddFrame(*step.sensors.ring, survey_.PoseAt(step.truth));
   }
 
  private:
   visual_localization::MapBuilder& builder_;
-  Survey& survey_;
+  SurveyPoses& survey_;
 };
 
 // Mean position error (m) of the map's keyframes against the ground truth at their stamps.
-nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const Survey& survey) {
+nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const SurveyPoses& survey) {
   std::vector<double> adjusted, surveyed;
   for (const auto& k : map.keyframes) {
     const auto truth = survey.truth().find(k.stamp);
@@ -78,14 +85,58 @@ nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const S
           {"adjusted_position_error_mean_m", ErrorStats::From(adjusted).mean}};
 }
 
+constexpr std::uint64_t kMappingSeedOffset = 1000;  // a scenario's mapping drive: other noise than its trials
+
+// The mapping drive: a drive plan played open loop, or a scenario whose goals the robot drives to
+// with its stack (navigating on the simulated fixes, or dead reckoning: the map does not exist yet).
+struct MappingDrive {
+  WorldSetup world;
+  double duration = 0.0;
+  std::optional<DrivePlan> plan;
+  std::optional<Scenario> scenario;
+  std::unique_ptr<stack::RobotStack> robot;
+  std::unique_ptr<Controller> controller;
+  std::optional<SimulatedPoseFixes> fixes;
+};
+
+std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
+  auto drive = std::make_unique<MappingDrive>();
+  if (!YamlMap::LoadFile(options.plan_path).Has("goals")) {
+    drive->plan = DrivePlan::Load(options.plan_path);
+    drive->world = drive->plan->world;
+    if (options.seed) drive->world.seed = *options.seed;
+    drive->duration = std::min(drive->plan->duration(), options.seconds.value_or(drive->plan->duration()));
+    drive->controller = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
+    return drive;
+  }
+  drive->scenario = Scenario::Load(options.plan_path);
+  const Scenario& scenario = *drive->scenario;
+  drive->world = scenario.world;
+  drive->world.seed = options.seed.value_or(scenario.world.seed + kMappingSeedOffset);
+  drive->duration = std::min(scenario.time_limit, options.seconds.value_or(scenario.time_limit));
+  stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
+  if (scenario.stack) parameters = parameters.Overridden(*scenario.stack);
+  if (parameters.localization == stack::LocalizationSource::kVisual) {
+    parameters.localization = stack::LocalizationSource::kSimulatedPoseFixes;
+  }
+  drive->robot = std::make_unique<stack::RobotStack>(options.paths.robot_files(), parameters, drive->world.seed);
+  drive->robot->SetInitialPose(0.0, {scenario.world.start.x, scenario.world.start.y, scenario.world.start.yaw});
+  drive->robot->SetMap(WritePriorMap(PriorMap(scenario, options.paths), options.out_dir + "/prior_map"));
+  drive->robot->SetGoals(scenario.goals);
+  if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
+    drive->fixes.emplace(scenario.simulated_pose_fixes, drive->world.seed);
+  }
+  drive->controller = std::make_unique<StackController>(*drive->robot);
+  return drive;
+}
+
 }  // namespace
 
 int RunMapBuild(const MapBuildOptions& options) {
   const auto wall_start = Clock::now();
-  const DrivePlan plan = DrivePlan::Load(options.plan_path);
-  WorldSetup world = plan.world;
-  if (options.seed) world.seed = *options.seed;
   std::filesystem::create_directories(options.out_dir);
+  const std::unique_ptr<MappingDrive> drive = LoadMappingDrive(options);
+  const WorldSetup& world = drive->world;
   sim::SimulatorConfig config = MakeSimulatorConfig(options.paths, world, options.out_dir + "/world");
   config.cameras_on_schedule = false;  // only the keyframes are rendered
   sim::Simulator simulator(config);
@@ -99,17 +150,17 @@ int RunMapBuild(const MapBuildOptions& options) {
   builder_options.survey_position_sigma = options.survey_position_sigma;
   builder_options.survey_rotation_sigma = options.survey_rotation_sigma_deg * M_PI / 180.0;
   visual_localization::MapBuilder builder(rig, builder_options);
-  Survey survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
+  SurveyPoses survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
 
-  const double duration = std::min(plan.duration(), options.seconds.value_or(plan.duration()));
-  DrivePlanPlayer player(plan, duration);
   MapRecorder recorder(builder, survey);
   LoopOptions loop;
-  loop.time_limit = duration;
+  loop.time_limit = drive->duration;
   loop.render_on_demand = true;
   loop.ring_demand = [&](const sim::GroundTruth& truth) { return builder.WantsFrame(survey.PoseAt(truth)); };
-  std::cout << "[map] driving " << options.plan_path << " (" << duration << " s), rendering keyframes" << std::endl;
-  RunClosedLoop(simulator, player, {&recorder}, loop);
+  loop.pose_fixes = drive->fixes ? &*drive->fixes : nullptr;
+  std::cout << "[map] driving " << options.plan_path << " (up to " << drive->duration << " s), rendering keyframes"
+            << std::endl;
+  RunClosedLoop(simulator, *drive->controller, {&recorder}, loop);
   const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
   visual_localization::MapBuildStats stats;

@@ -1,5 +1,7 @@
 #pragma once
-// `trimbot map build`: a mapping drive (a drive plan), rendered only where the map builder takes a
+// `trimbot map build`: a mapping drive - a drive plan played open loop, or a scenario whose goals
+// the robot's stack drives to (on the simulated pose fixes or dead reckoning, as the map does not
+// exist yet; with a seed 1000 above the scenario's) - rendered only where the map builder takes a
 // keyframe, with survey poses = ground truth + seeded noise (as the real map was tied to a laser
 // tracker), through the stack's MapBuilder into one map file. Writes into the output folder:
 //   map.sqlite        the map (VisualMap)
