@@ -133,9 +133,10 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const sim::RingCapture capture = simulator.CaptureRing(false);
   const Eigen::Isometry3d truth = simulator.ground_truth().T_map_base;
 
-  for (const auto retrieval : {Retrieval::kVocabulary, Retrieval::kCombined}) {
+  for (const auto retrieval : {Retrieval::kVocabulary, Retrieval::kCombined, Retrieval::kPosePrior}) {
     LocalizerOptions options;
     options.retrieval = retrieval;
+    if (retrieval == Retrieval::kPosePrior) options.cameras = {0, 2, 4, 6, 8};  // the left cameras alone
     VisualLocalizer localizer(VisualMap::Load(dir + "/map.sqlite", "test_lawn", RigSignature(rig)), rig, options);
     const std::optional<Eigen::Vector2d> prior =
         retrieval == Retrieval::kVocabulary ? std::nullopt

@@ -113,6 +113,9 @@ void RobotStack::SetVisualMap(const std::string& map_path) {
   options.keyframes = v.keyframes;
   options.prior_radius = v.prior_radius;
   options.pose.min_inliers = v.min_inliers;
+  if (v.left_cameras_only) {
+    for (const auto& pair : components_->rig.StereoPairs()) options.cameras.push_back(pair.left);
+  }
   components_->localizer = std::make_unique<visual_localization::VisualLocalizer>(
       visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(components_->rig)),
       components_->rig, options);

@@ -70,6 +70,11 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
   r.Number("latency_log_sigma", &p.latency_log_sigma, 0.0, 10.0);
   r.Number("latency_max", &p.latency_max, 1e-3, 60.0, "s");
   r.Integer("features", &p.features, 50, 100000);
+  if (r.Wanted("cameras")) {
+    const std::string cameras = r.map().String("cameras");
+    if (cameras != "all" && cameras != "left") r.map().Fail("cameras", "must be all or left");
+    p.left_cameras_only = cameras == "left";
+  }
   r.Integer("keyframes", &p.keyframes, 1, 1000);
   r.Number("prior_radius", &p.prior_radius, 0.1, 1000.0, "m");
   r.Integer("min_inliers", &p.min_inliers, 4, 100000);

@@ -88,6 +88,10 @@ VisualLocalizer::FrameFeatures VisualLocalizer::Extract(const messages::RingFram
   std::vector<cv::Mat> descriptors;
   for (const auto& image : frame.images) {
     if (image.camera_index < 0 || image.camera_index >= rig_.size() || image.data.empty()) continue;
+    if (!options_.cameras.empty() &&
+        std::find(options_.cameras.begin(), options_.cameras.end(), image.camera_index) == options_.cameras.end()) {
+      continue;
+    }
     const Features f = ExtractFeatures(Grey(image), options_.features);
     const robot::PinholeRadtan& camera = rig_.camera(image.camera_index).intrinsics;
     const double scale = static_cast<double>(image.width) / camera.width;

@@ -25,6 +25,7 @@ struct VisualLocalizationParameters {
   double latency_log_sigma = 0.35;   //     like the real pipeline's (Figure 10 of D3.4)
   double latency_max = 1.5;          // s
   int features = 1000;               // Upright-SIFT keypoints per camera image
+  bool left_cameras_only = false;    // the left camera of each stereo pair (half the work)
   int keyframes = 5;                 // retrieved keyframes whose points are matched
   double prior_radius = 3.0;         // m around the EKF's position
   int min_inliers = 12;

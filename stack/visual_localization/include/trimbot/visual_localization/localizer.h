@@ -30,6 +30,7 @@ struct LocalizerOptions {
   double prior_radius = 3.0;     // m: with a pose prior, only keyframes this close are candidates
   double ratio = 0.8;            // Lowe's ratio test
   RigPoseOptions pose;
+  std::vector<int> cameras;      // ring cameras used (empty: every camera in the frame)
   double min_position_sigma = 0.02;          // m: floor of the reported covariance
   double min_yaw_sigma = 0.5 * M_PI / 180;   // rad
 };
