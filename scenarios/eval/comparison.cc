@@ -15,10 +15,6 @@ namespace {
 
 using nlohmann::json;
 
-double Mean(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
 // Mean of one estimate's samples in one trial (nullopt when it has none).
 std::optional<double> TrialMean(const json& trial, const std::string& estimate, const std::string& field) {
   if (!trial.contains("estimates")) return std::nullopt;

@@ -10,10 +10,6 @@
 namespace trimbot::scenarios {
 namespace {
 
-double Mean(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
 double LogChoose(int n, int k) { return std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0); }
 
 Interval Percentiles(std::vector<double> values) {
@@ -58,6 +54,10 @@ double RankSumOfB(const std::vector<double>& a, const std::vector<double>& b, do
 }
 
 }  // namespace
+
+double Mean(const std::vector<double>& values) {
+  return values.empty() ? 0.0 : std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
 
 Interval WilsonInterval(int successes, int n, double z) {
   if (n <= 0) return {0.0, 1.0};

@@ -13,6 +13,9 @@ struct Interval {
   double low = 0.0, high = 0.0;
 };
 
+// Arithmetic mean (0 for no values).
+double Mean(const std::vector<double>& values);
+
 // 95 % (z = 1.96) Wilson score interval of a rate of `successes` in `n`.
 Interval WilsonInterval(int successes, int n, double z = 1.959964);
 

@@ -22,6 +22,7 @@
 #include "trimbot/stack/robot_stack.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/random.h"
+#include "trimbot/common/rotation.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/robot_description.h"
 #include "trimbot/visual_localization/map_builder.h"
@@ -45,7 +46,7 @@ class SurveyPoses {
     const Eigen::Vector3d dr(normal_(rng_), normal_(rng_), normal_(rng_));
     pose.translation() += position_sigma_ * dp;
     const Eigen::Vector3d w = rotation_sigma_ * dr;
-    if (w.norm() > 0.0) pose.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * pose.linear();
+    pose.linear() = RotationFromVector(w) * pose.linear();
     truth_[truth.stamp] = truth.T_map_base;
     return poses_.emplace(truth.stamp, pose).first->second;
   }

@@ -7,6 +7,7 @@
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
+#include "trimbot/common/rotation.h"
 #include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/camera_rig.h"
@@ -61,8 +62,7 @@ Eigen::Isometry3d SmallMotion(Rng& rng, double rotation_sigma, double translatio
   const Eigen::Vector3d w(normal(rng), normal(rng), normal(rng));
   const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  const Eigen::Vector3d rotation = rotation_sigma * w;
-  if (rotation.norm() > 0.0) motion.linear() = Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix();
+  motion.linear() = RotationFromVector(rotation_sigma * w);
   motion.translation() = translation_sigma * t;
   return motion;
 }

@@ -166,10 +166,7 @@ int RunSweep(const SweepOptions& options) {
     const auto estimates = BatchEstimates(json::parse(in));
     results.push_back(PointJson(grids, points[i], i, estimates));
     std::cout << "[sweep] point " << i;
-    for (const auto& o : std::vector<std::string>(batch.overrides.end() - static_cast<std::ptrdiff_t>(grids.size()),
-                                                  batch.overrides.end())) {
-      std::cout << " " << o;
-    }
+    for (std::size_t g = 0; g < grids.size(); ++g) std::cout << " " << grids[g].key << "=" << grids[g].values[points[i][g]];
     std::cout << std::setprecision(4) << ": success " << estimates[0].value << " [" << estimates[0].interval.low
               << ", " << estimates[0].interval.high << "], EKF error " << estimates[2].value << " m" << std::endl;
   }

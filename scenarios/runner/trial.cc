@@ -17,13 +17,14 @@
 namespace trimbot::scenarios {
 namespace {
 
-sim::SimulatorConfig PlantFor(const TrialSetup& setup) {
+// `render_for_stack`: the stack's localization asks for the ring frames it uses.
+sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   const Scenario& scenario = *setup.scenario;
   WorldSetup world = scenario.world;
   world.seed = setup.seed;
   sim::SimulatorConfig config = MakeSimulatorConfig(setup.paths, world, setup.dir + "/world");
-  config.render_cameras = scenario.render_cameras || setup.render_for_stack;
-  config.cameras_on_schedule = !setup.render_for_stack;  // the stack asks for the frames it uses
+  config.render_cameras = scenario.render_cameras || render_for_stack;
+  config.cameras_on_schedule = !render_for_stack;
   config.resolution_scale = scenario.resolution_scale;
   config.faults = scenario.faults;
   config.imu_noise_scale = scenario.imu_noise_scale;
@@ -60,9 +61,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
   const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
-  TrialSetup plant_setup = setup;
-  plant_setup.render_for_stack = visual;
-  sim::Simulator simulator(PlantFor(plant_setup));
+  sim::Simulator simulator(PlantFor(setup, visual));
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
   robot.SetMap(setup.map_yaml);

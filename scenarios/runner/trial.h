@@ -22,7 +22,6 @@ struct TrialSetup {
   std::string dir;        // this trial's output folder
   int index = 0;
   std::uint64_t seed = 0;
-  bool render_for_stack = false;  // set by RunTrial: the stack's localization asks for ring frames
 };
 
 // Runs the trial; `progress(simulated_seconds)` is called about once per simulated second.

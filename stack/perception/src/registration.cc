@@ -1,3 +1,4 @@
+#include "trimbot/common/rotation.h"
 #include "trimbot/perception/registration.h"
 
 #include <Eigen/Cholesky>
@@ -114,12 +115,6 @@ Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const st
   T.linear() = svd.matrixV() * d * svd.matrixU().transpose();
   T.translation() = mean_x - T.linear() * mean_y;
   return T;
-}
-
-Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (angle < 1e-12) return Eigen::Matrix3d::Identity() + Skew(w);
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
 }
 
 }  // namespace
@@ -323,7 +318,7 @@ Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud&
   if (pairs > 0) {
     const Vector6 delta = -(H + 1e-9 * Matrix6::Identity()).ldlt().solve(g);
     if (delta.allFinite()) {
-      next.linear() = ExpSO3(delta.head<3>()) * T.linear();
+      next.linear() = RotationFromVector(delta.head<3>()) * T.linear();
       next.translation() = T.translation() + delta.tail<3>();
     }
   }

@@ -146,10 +146,7 @@ void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
 
 void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
-  if (parameters_.localization == LocalizationSource::kVisual && components_->localizer &&
-      frame.stamp + 1e-9 >= next_localization_ && frame.stamp >= localizer_busy_until_) {
-    LocalizeVisually(frame);
-  }
+  if (VisualLocalizationDue(frame.stamp)) LocalizeVisually(frame);
   if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
     ScopedTimer timer(&telemetry_.timings.perception);
     // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
@@ -166,17 +163,23 @@ void RobotStack::Add(const messages::PoseFix& fix) {
   components_->ekf.AddPoseFix(fix);
 }
 
+bool RobotStack::VisualLocalizationDue(double stamp) const {
+  return parameters_.localization == LocalizationSource::kVisual && components_->localizer &&
+         stamp + 1e-9 >= next_localization_ && stamp >= localizer_busy_until_;
+}
+
 bool RobotStack::WantsRingFrame(double stamp) const {
-  const bool localization = parameters_.localization == LocalizationSource::kVisual && components_->localizer &&
-                            stamp + 1e-9 >= next_localization_ && stamp >= localizer_busy_until_;
-  return localization || (components_->fusion != nullptr && components_->fusion->Wants(stamp));
+  return VisualLocalizationDue(stamp) || (components_->fusion != nullptr && components_->fusion->Wants(stamp));
 }
 
 void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
   ScopedTimer timer(&telemetry_.timings.localization);
   Components& c = *components_;
   std::optional<Eigen::Vector2d> prior;
-  if (c.ekf.initialized()) prior = Eigen::Vector2d(c.ekf.Estimate().pose.x, c.ekf.Estimate().pose.y);
+  if (c.ekf.initialized()) {
+    const Pose2 estimate = c.ekf.Estimate().pose;
+    prior = Eigen::Vector2d(estimate.x, estimate.y);
+  }
   const auto start = std::chrono::steady_clock::now();
   const visual_localization::LocalizationResult result = c.localizer->Localize(frame, prior);
   const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

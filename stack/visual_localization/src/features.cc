@@ -1,6 +1,7 @@
 #include "trimbot/visual_localization/features.h"
 
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <stdexcept>
@@ -32,6 +33,25 @@ Features ExtractFeatures(const cv::Mat& grey, const FeatureOptions& options) {
   f.keypoints = std::move(detected);
   sift->compute(grey, f.keypoints, f.descriptors);
   return f;
+}
+
+ImageFeatures ExtractImageFeatures(const messages::Image& image, const robot::PinholeRadtan& camera,
+                                   const FeatureOptions& options) {
+  const cv::Mat raw(image.height, image.width, image.encoding == "mono8" ? CV_8UC1 : CV_8UC3,
+                    const_cast<std::uint8_t*>(image.data.data()));
+  cv::Mat grey = raw;
+  if (raw.channels() == 3) cv::cvtColor(raw, grey, cv::COLOR_RGB2GRAY);
+  const Features features = ExtractFeatures(grey, options);
+  const double scale = static_cast<double>(image.width) / camera.width;  // rendered at a fraction
+  ImageFeatures out;
+  out.descriptors = features.descriptors;
+  for (const auto& k : features.keypoints) {
+    const Eigen::Vector2d pixel((k.pt.x + 0.5) / scale - 0.5, (k.pt.y + 0.5) / scale - 0.5);
+    const Eigen::Vector2d normalized = camera.Undistort(pixel);
+    out.pixels.push_back(pixel);
+    out.bearings.push_back(Eigen::Vector3d(normalized.x(), normalized.y(), 1.0).normalized());
+  }
+  return out;
 }
 
 }  // namespace trimbot::visual_localization

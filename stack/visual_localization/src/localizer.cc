@@ -1,7 +1,6 @@
 #include "trimbot/visual_localization/localizer.h"
 
 #include <opencv2/features2d.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -14,15 +13,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-cv::Mat Grey(const messages::Image& image) {
-  const cv::Mat raw(image.height, image.width, image.encoding == "mono8" ? CV_8UC1 : CV_8UC3,
-                    const_cast<std::uint8_t*>(image.data.data()));
-  if (raw.channels() == 1) return raw;
-  cv::Mat grey;
-  cv::cvtColor(raw, grey, cv::COLOR_RGB2GRAY);
-  return grey;
-}
 
 }  // namespace
 
@@ -92,15 +82,9 @@ VisualLocalizer::FrameFeatures VisualLocalizer::Extract(const messages::RingFram
         std::find(options_.cameras.begin(), options_.cameras.end(), image.camera_index) == options_.cameras.end()) {
       continue;
     }
-    const Features f = ExtractFeatures(Grey(image), options_.features);
-    const robot::PinholeRadtan& camera = rig_.camera(image.camera_index).intrinsics;
-    const double scale = static_cast<double>(image.width) / camera.width;
-    for (const auto& k : f.keypoints) {
-      const Eigen::Vector2d pixel((k.pt.x + 0.5) / scale - 0.5, (k.pt.y + 0.5) / scale - 0.5);
-      const Eigen::Vector2d n = camera.Undistort(pixel);
-      out.camera.push_back(image.camera_index);
-      out.bearings.push_back(Eigen::Vector3d(n.x(), n.y(), 1.0).normalized());
-    }
+    const ImageFeatures f = ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
+    out.camera.insert(out.camera.end(), f.bearings.size(), image.camera_index);
+    out.bearings.insert(out.bearings.end(), f.bearings.begin(), f.bearings.end());
     if (!f.descriptors.empty()) descriptors.push_back(f.descriptors);
   }
   if (!descriptors.empty()) cv::vconcat(descriptors, out.descriptors);

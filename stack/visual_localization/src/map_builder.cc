@@ -3,7 +3,6 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <opencv2/features2d.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +12,8 @@
 #include <map>
 #include <optional>
 #include <numeric>
+
+#include "trimbot/common/rotation.h"
 
 namespace trimbot::visual_localization {
 namespace {
@@ -261,8 +262,7 @@ double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, std
   if (!blocks.empty()) ceres::Solve(solver, &problem, &summary);
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const Eigen::Vector3d w(poses[k][0], poses[k][1], poses[k][2]);
-    keyframes[k].T_map_base.linear() =
-        w.norm() < 1e-15 ? Eigen::Matrix3d::Identity() : Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    keyframes[k].T_map_base.linear() = RotationFromVector(w);
     keyframes[k].T_map_base.translation() << poses[k][3], poses[k][4], poses[k][5];
   }
   // RMS of the pixel residuals (the cost functions are scaled by 1/sigma).
@@ -297,25 +297,6 @@ bool MapBuilder::WantsFrame(const Eigen::Isometry3d& T) const {
          RotationAngle(last.linear().transpose() * T.linear()) >= options_.keyframe_angle;
 }
 
-MappingImage MapBuilder::Extract(const messages::Image& image) const {
-  const cv::Mat raw(image.height, image.width, image.encoding == "mono8" ? CV_8UC1 : CV_8UC3,
-                    const_cast<std::uint8_t*>(image.data.data()));
-  cv::Mat grey = raw;
-  if (raw.channels() == 3) cv::cvtColor(raw, grey, cv::COLOR_RGB2GRAY);
-  const Features features = ExtractFeatures(grey, options_.features);
-  const robot::PinholeRadtan& camera = rig_.camera(image.camera_index).intrinsics;
-  const double scale = static_cast<double>(image.width) / camera.width;  // rendered at a fraction
-  MappingImage out;
-  out.descriptors = features.descriptors;
-  for (const auto& k : features.keypoints) {
-    const Eigen::Vector2d pixel((k.pt.x + 0.5) / scale - 0.5, (k.pt.y + 0.5) / scale - 0.5);
-    const Eigen::Vector2d normalized = camera.Undistort(pixel);
-    out.pixels.push_back(pixel);
-    out.bearings.push_back(Eigen::Vector3d(normalized.x(), normalized.y(), 1.0).normalized());
-  }
-  return out;
-}
-
 bool MapBuilder::AddFrame(const messages::RingFrame& frame, const Eigen::Isometry3d& T_map_base_survey) {
   ++stats_.frames;
   if (!WantsFrame(T_map_base_survey)) return false;
@@ -326,7 +307,8 @@ bool MapBuilder::AddFrame(const messages::RingFrame& frame, const Eigen::Isometr
   keyframe.images.resize(static_cast<std::size_t>(rig_.size()));
   for (const auto& image : frame.images) {
     if (image.camera_index >= 0 && image.camera_index < rig_.size()) {
-      keyframe.images[static_cast<std::size_t>(image.camera_index)] = Extract(image);
+      keyframe.images[static_cast<std::size_t>(image.camera_index)] =
+          ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
     }
   }
   keyframes_.push_back(std::move(keyframe));

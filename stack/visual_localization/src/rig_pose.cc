@@ -9,16 +9,12 @@
 #include <cmath>
 #include <memory>
 
+#include "trimbot/common/rotation.h"
+
 namespace trimbot::visual_localization {
 namespace {
 
 using Problem = opengv::sac_problems::absolute_pose::AbsolutePoseSacProblem;
-
-Eigen::Matrix3d Exp(const Eigen::Vector3d& w) {
-  const double angle = w.norm();
-  if (angle < 1e-15) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-}
 
 // Angular residual components of one correspondence for T_map_base (the bearing's deviation from
 // the ray to the point, as the two components orthogonal to the bearing).
@@ -43,7 +39,7 @@ Eigen::Matrix<double, 6, 6> Covariance(const std::vector<Correspondence>& corres
       Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
       delta(k) = h;
       Eigen::Isometry3d perturbed = T;
-      perturbed.linear() = Exp(delta.head<3>()) * T.linear();
+      perturbed.linear() = RotationFromVector(delta.head<3>()) * T.linear();
       perturbed.translation() += delta.tail<3>();
       J.col(k) = (Residual(c, Tc, perturbed) - r0) / h;
     }

@@ -104,6 +104,8 @@ class RobotStack {
 
  private:
   void RunNavigation(double stamp, messages::RobotCommands* commands);
+  // The localizer is configured, idle and its rate allows a frame at `stamp`.
+  bool VisualLocalizationDue(double stamp) const;
   void LocalizeVisually(const messages::RingFrame& frame);
   void DeliverVisualFixes(double stamp);
   bool LocalizationLost() const;

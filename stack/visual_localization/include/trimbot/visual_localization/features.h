@@ -7,9 +7,13 @@
 // merged before the descriptors are computed, and OpenCV's SIFT computes a descriptor in the
 // keypoint's own orientation frame - so with angle 0 the descriptor grid stays aligned with the
 // image axes and is not rotated.
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include <vector>
+
+#include "trimbot/messages/sensor_messages.h"
+#include "trimbot/robot/camera_rig.h"
 
 namespace trimbot::visual_localization {
 
@@ -25,5 +29,15 @@ struct Features {
 
 // Features of an 8-bit grayscale image. std::invalid_argument if it is not CV_8UC1.
 Features ExtractFeatures(const cv::Mat& grey, const FeatureOptions& options = {});
+
+// The features of one ring image with their rays, as mapping and localization use them.
+struct ImageFeatures {
+  std::vector<Eigen::Vector2d> pixels;    // in the calibration's resolution
+  std::vector<Eigen::Vector3d> bearings;  // unit rays in the camera's optical frame
+  cv::Mat descriptors;
+};
+// `camera`: the image's calibration; an image rendered at a fraction of it is scaled back.
+ImageFeatures ExtractImageFeatures(const messages::Image& image, const robot::PinholeRadtan& camera,
+                                   const FeatureOptions& options);
 
 }  // namespace trimbot::visual_localization

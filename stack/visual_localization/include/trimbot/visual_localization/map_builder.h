@@ -48,11 +48,7 @@ struct MapBuildStats {
 };
 
 // Plain data between the stages.
-struct MappingImage {
-  std::vector<Eigen::Vector3d> bearings;  // unit rays in the camera frame
-  std::vector<Eigen::Vector2d> pixels;    // in the calibration's resolution
-  cv::Mat descriptors;
-};
+using MappingImage = ImageFeatures;
 struct MappingKeyframe {
   double stamp = 0.0;
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // survey pose
@@ -71,8 +67,6 @@ class MapBuilder {
   VisualMap Build(const std::string& garden, MapBuildStats* stats);
 
  private:
-  MappingImage Extract(const messages::Image& image) const;
-
   robot::CameraRig rig_;
   MapBuilderOptions options_;
   std::vector<MappingKeyframe> keyframes_;
