@@ -11,6 +11,7 @@
 #include "runner/closed_loop.h"
 #include "runner/controllers.h"
 #include "runner/drive_plan.h"
+#include "runner/localization_eval.h"
 #include "runner/mapping.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
@@ -59,6 +60,7 @@ TEST(VisualMap, RoundTripsThroughItsFile) {
   EXPECT_EQ(read.observations[3].pixel, map.observations[3].pixel);
   EXPECT_EQ(read.observations[3].camera, 3);
   EXPECT_EQ(cv::norm(read.vocabulary, map.vocabulary, cv::NORM_INF), 0.0);
+  EXPECT_EQ(read.descriptor, map.descriptor);
 }
 
 TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
@@ -75,6 +77,8 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
   };
   EXPECT_NE(message([&] { VisualMap::Load(good, "wageningen"); }).find("made in garden 'test_lawn'"), std::string::npos);
   EXPECT_NE(message([&] { VisualMap::Load(good, "", "ffffffffffffffff"); }).find("another camera rig"), std::string::npos);
+  EXPECT_NE(message([&] { VisualMap::Load(good, "", "", Descriptor::kSift); }).find("descriptor is upright_sift"),
+            std::string::npos);
   const std::string garbage = testing::WriteTempFile("garbage.sqlite", "this is not a database at all");
   EXPECT_NE(message([&] { VisualMap::Load(garbage); }).find(garbage), std::string::npos);
   // Truncated: half of a real map file.
@@ -86,12 +90,19 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
   EXPECT_NE(message([&] { VisualMap::Load(dir + "/missing.sqlite"); }).find("not found"), std::string::npos);
 }
 
-TEST(MapBuild, AShortDriveGivesAConsistentMap) {
+// A map of the first 6 s of the lawn loop, built into `dir` (each test builds its own: ctest may
+// run them in any order, in parallel).
+scenarios::MapBuildOptions ShortLawnMap(const std::string& dir) {
   scenarios::MapBuildOptions options;
   options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
-  options.out_dir = testing::TempDir("map_build");
+  options.out_dir = dir;
   options.paths = {TRIMBOT_SOURCE_DIR};
   options.seconds = 6.0;
+  return options;
+}
+
+TEST(MapBuild, AShortDriveGivesAConsistentMap) {
+  const scenarios::MapBuildOptions options = ShortLawnMap(testing::TempDir("map_build"));
   ASSERT_EQ(scenarios::RunMapBuild(options), 0);
   std::ifstream in(options.out_dir + "/map_stats.json");
   const nlohmann::json stats = nlohmann::json::parse(in);
@@ -115,11 +126,11 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
 // retrieves a keyframe within 1 m of the true pose, and the ring's pose comes out within a few
 // centimetres - with and without a pose prior.
 TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
-  const std::string dir = testing::TempDir("map_build");  // built by the test above (same process)
+  const std::string dir = testing::TempDir("map_for_queries");
+  ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
   const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
   const robot::CameraRig rig = robot::CameraRig::LoadKalibr(
       files.camchain, robot::RobotDescription::Load(files.urdf).FramePose(robot::RobotFrames::CameraOptical(0)));
-  ASSERT_TRUE(std::filesystem::exists(dir + "/map.sqlite")) << "run MapBuild.AShortDriveGivesAConsistentMap first";
   const scenarios::DrivePlan plan = scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drives/lawn_loop.yaml"));
   scenarios::WorldSetup world = plan.world;
   world.seed = 77;
@@ -163,6 +174,47 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const LocalizationResult none = localizer.Localize(empty, std::nullopt);
   EXPECT_FALSE(none.success);
   EXPECT_FALSE(none.failure.empty());
+}
+
+// The offline evaluations on a query drive of another seed, 20 cm to the side of the mapped one:
+// the bench localizes its frames (fixes, errors against ground truth, a time per stage for every
+// frame, the histogram), the retrieval evaluation fills Table 4's rows for the three methods.
+TEST(LocalizationEval, BenchAndRetrievalOnAQueryDriveBesideTheMappedOne) {
+  const std::string dir = testing::TempDir("map_for_eval");
+  ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
+  scenarios::LocalizationEvalOptions options;
+  options.map_path = dir + "/map.sqlite";
+  options.drive.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.drive.seconds = 6.0;
+  options.drive.interval = 1.0;
+  options.drive.lateral_offset = 0.2;
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  options.out_dir = dir + "/bench";
+  ASSERT_EQ(scenarios::RunLocalizationBench(options), 0);
+  std::ifstream bench_file(options.out_dir + "/localization_bench.json");
+  const nlohmann::json bench = nlohmann::json::parse(bench_file);
+  const int frames = bench["frames"].get<int>();
+  EXPECT_GE(frames, 5);
+  EXPECT_GE(bench["fix_rate"].get<double>(), 0.8);
+  EXPECT_LT(bench["position_error_m"]["median"].get<double>(), 0.05);
+  EXPECT_EQ(static_cast<int>(bench["time"]["frames_ms"].size()), frames);
+  EXPECT_GT(bench["time"]["total"]["median_ms"].get<double>(), 0.0);
+  EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/localization_time.png"));
+
+  options.out_dir = dir + "/retrieval";
+  ASSERT_EQ(scenarios::RunRetrievalEval(options), 0);
+  std::ifstream retrieval_file(options.out_dir + "/retrieval_eval.json");
+  const nlohmann::json retrieval = nlohmann::json::parse(retrieval_file);
+  const VisualMap map = VisualMap::Load(options.map_path);  // a short map: every keyframe is retrieved
+  for (const char* method : {"vocabulary", "pose_prior", "combined"}) {
+    const auto& row = retrieval["methods"][method];
+    EXPECT_EQ(row["retrieved_keyframes"].get<int>(), frames * std::min<int>(20, map.keyframes.size())) << method;
+    const double rig50 = row["rig_percent"][">=50"].get<double>();
+    EXPECT_GE(rig50, row["rig_percent"][">=100"].get<double>()) << method;
+    EXPECT_GE(row["single_image_percent"][">=50"].get<double>(), row["single_image_percent"][">=200"].get<double>());
+  }
+  // The nearest keyframes share the most: the rigs' best retrieval has >= 50 verified matches.
+  EXPECT_GT(retrieval["methods"]["pose_prior"]["rig_percent"][">=50"].get<double>(), 50.0);
 }
 
 }  // namespace

@@ -91,8 +91,8 @@ TEST(UprightSift, DescriptorsOfARotatedImageDifferOrdinarySiftsDoNot) {
 
   double median_distance[2] = {0, 0};
   for (const bool upright : {true, false}) {
-    const Features a = ExtractFeatures(grey, {2000, upright});
-    const Features b = ExtractFeatures(rotated, {2000, upright});
+    const Features a = ExtractFeatures(grey, {2000, upright ? Descriptor::kUprightSift : Descriptor::kSift});
+    const Features b = ExtractFeatures(rotated, {2000, upright ? Descriptor::kUprightSift : Descriptor::kSift});
     ASSERT_GT(a.keypoints.size(), 200u);
     // The same physical keypoint in both images: its position mapped by the rotation, same scale.
     std::vector<double> distances;

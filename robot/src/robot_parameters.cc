@@ -45,6 +45,14 @@ RobotParameters RobotParameters::Load(const std::string& path) {
   const YamlMap cameras = root.Map("cameras");
   config.cameras.rate_hz = Positive(cameras, "rate_hz");
   config.cameras.noise_sigma = NonNegative(cameras, "noise_sigma");
+  const YamlMap exposure = cameras.Map("auto_exposure");
+  AutoExposure& ae = config.cameras.auto_exposure;
+  ae.enabled = exposure.Bool("enabled");
+  ae.target_mean = exposure.Number("target_mean", 1.0, 254.0, "grey levels");
+  ae.metering_top = exposure.Number("metering_top", 0.0, 0.95);
+  ae.max_exposure_factor = exposure.Number("max_exposure_factor", 1.0, 1000.0);
+  ae.max_gain = exposure.Number("max_gain", 1.0, 1000.0);
+  exposure.RejectUnknownKeys();
   cameras.RejectUnknownKeys();
 
   const YamlMap drive = root.Map("drive");

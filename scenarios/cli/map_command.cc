@@ -2,9 +2,52 @@
 
 #include <memory>
 
+#include "runner/localization_eval.h"
 #include "runner/mapping.h"
 
 namespace trimbot::scenarios {
+namespace {
+
+// The options `map bench` and `map retrieval-eval` share: the map, the query drive, the stack's
+// overrides; `run` is called with them once parsed.
+void AddEvalCommand(CLI::App* map, const std::string& name, const std::string& help, const std::string& data_root,
+                    int& exit_code, int (*run)(const LocalizationEvalOptions&)) {
+  auto options = std::make_shared<LocalizationEvalOptions>();
+  auto seed = std::make_shared<std::uint64_t>(0);
+  auto time_of_day = std::make_shared<double>(0.0);
+  auto day = std::make_shared<int>(0);
+  auto growth = std::make_shared<double>(0.0);
+  auto* command = map->add_subcommand(name, help);
+  command->add_option("map", options->map_path, "map file (map.sqlite)")->required();
+  command->add_option("plan", options->drive.plan_path, "drive plan (YAML) of the query drive")->required();
+  command->add_option("--out", options->out_dir, "output folder")->required();
+  auto* seed_option = command->add_option("--seed", *seed, "seed of the query drive (default: the plan's + 2000)");
+  auto* time_option = command->add_option("--time-of-day", *time_of_day, "h (default: the plan's)")->check(CLI::Range(0.0, 24.0));
+  auto* day_option = command->add_option("--day-of-year", *day, "(default: the plan's)")->check(CLI::Range(1, 366));
+  auto* growth_option = command->add_option("--growth", *growth, "0..1 (default: the plan's)")->check(CLI::Range(0.0, 1.0));
+  command->add_option("--lateral-offset", options->drive.lateral_offset, "m: drive this far left of the plan's start")
+      ->check(CLI::Range(-5.0, 5.0));
+  command->add_option("--interval", options->drive.interval, "s between query frames")->check(CLI::PositiveNumber);
+  auto seconds = std::make_shared<double>(0.0);
+  auto* seconds_option = command->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
+                             ->check(CLI::PositiveNumber);
+  command->add_option("--resolution-scale", options->drive.resolution_scale, "render at this fraction of 752x480")
+      ->check(CLI::Range(0.1, 1.0));
+  command->add_option("--prior-sigma", options->prior_sigma, "m: noise of the position prior (truth + noise)")
+      ->check(CLI::Range(0.0, 100.0));
+  command->add_option("--set", options->stack_overrides, "override a stack.yaml key, e.g. visual_localization.cameras=left");
+  command->callback([=, &data_root, &exit_code]() {
+    options->paths = {data_root};
+    if (seed_option->count() > 0) options->drive.seed = *seed;
+    if (time_option->count() > 0) options->drive.time_of_day = *time_of_day;
+    if (day_option->count() > 0) options->drive.day_of_year = *day;
+    if (growth_option->count() > 0) options->drive.growth = *growth;
+    if (seconds_option->count() > 0) options->drive.seconds = *seconds;
+    exit_code = run(*options);
+  });
+}
+
+}  // namespace
 
 void AddMapCommands(CLI::App& app, const std::string& data_root, int& exit_code) {
   auto* map = app.add_subcommand("map", "visual localization maps");
@@ -22,12 +65,21 @@ void AddMapCommands(CLI::App& app, const std::string& data_root, int& exit_code)
       ->check(CLI::Range(0.0, 1.0));
   build->add_option("--survey-rotation-sigma-deg", options->survey_rotation_sigma_deg, "survey rotation noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
-  build->callback([options, seed, seconds, seed_option, seconds_option, &data_root, &exit_code]() {
+  auto descriptor = std::make_shared<std::string>();
+  build->add_option("--descriptor", *descriptor, "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)")
+      ->check(CLI::IsMember({"upright_sift", "sift"}));
+  build->callback([options, seed, seconds, seed_option, seconds_option, descriptor, &data_root, &exit_code]() {
+    if (!descriptor->empty()) options->descriptor = visual_localization::DescriptorFromString(*descriptor);
     options->paths = {data_root};
     if (seed_option->count() > 0) options->seed = *seed;
     if (seconds_option->count() > 0) options->seconds = *seconds;
     exit_code = RunMapBuild(*options);
   });
+  AddEvalCommand(map, "bench", "localize ring frames of a query drive: fixes, errors, time per stage (median) and its histogram",
+                 data_root, exit_code, RunLocalizationBench);
+  AddEvalCommand(map, "retrieval-eval",
+                 "D3.4 Table 4: top-5 retrieved keyframes with >= 50/100/200 verified matches (vocabulary, pose prior, combined)",
+                 data_root, exit_code, RunRetrievalEval);
 }
 
 }  // namespace trimbot::scenarios

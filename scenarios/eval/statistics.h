@@ -15,6 +15,8 @@ struct Interval {
 
 // Arithmetic mean (0 for no values).
 double Mean(const std::vector<double>& values);
+// The q-quantile (0..1) by linear interpolation between order statistics (0 for no values).
+double Percentile(std::vector<double> values, double q);
 
 // 95 % (z = 1.96) Wilson score interval of a rate of `successes` in `n`.
 Interval WilsonInterval(int successes, int n, double z = 1.959964);

@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "reports/batch_report.h"
+#include "reports/localization_timing.h"
 #include "runner/prior_knowledge.h"
 #include "runner/scenario.h"
 #include "runner/trial.h"
@@ -121,12 +122,28 @@ std::string OneLine(const TrialResult& r) {
 void WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
   json trials = json::array();
   double total = 0.0;
+  std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
   for (const auto& r : results) {
     trials.push_back({{"index", r.index}, {"seed", r.seed}, {"wall_seconds", r.wall_seconds}});
     total += r.wall_seconds;
+    const std::string trial_timing = TrialDir(out, r.index) + "/timing.json";
+    if (!fs::exists(trial_timing)) continue;
+    std::ifstream file(trial_timing);
+    const json timing = json::parse(file, nullptr, false);
+    if (timing.is_object() && timing.contains("visual_localization")) {
+      const auto trial_frames = LocalizationTimesFromJson(timing["visual_localization"]);
+      frames.insert(frames.end(), trial_frames.begin(), trial_frames.end());
+    }
   }
-  WriteFileAtomically(out + "/timing.json",
-                      json{{"trials", trials}, {"mean_wall_seconds", results.empty() ? 0.0 : total / results.size()}}.dump(2));
+  json report{{"trials", trials}, {"mean_wall_seconds", results.empty() ? 0.0 : total / results.size()}};
+  if (!frames.empty()) {
+    report["visual_localization"] = LocalizationTimeStats(frames);
+    report["visual_localization"].erase("frames_ms");  // in the trials' files
+    WriteLocalizationTimeHistogram(out + "/localization_time.png",
+                                   "visual localization time per frame, " + std::to_string(results.size()) + " trials",
+                                   frames);
+  }
+  WriteFileAtomically(out + "/timing.json", report.dump(2));
 }
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.

@@ -98,10 +98,12 @@ struct MappingDrive {
   std::unique_ptr<stack::RobotStack> robot;
   std::unique_ptr<Controller> controller;
   std::optional<SimulatedPoseFixes> fixes;
+  visual_localization::Descriptor descriptor;  // the stack's, whose localizer will use the map
 };
 
 std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   auto drive = std::make_unique<MappingDrive>();
+  drive->descriptor = stack::StackParameters::Load(options.paths.robot_files().stack_parameters).visual.descriptor;
   if (!YamlMap::LoadFile(options.plan_path).Has("goals")) {
     drive->plan = DrivePlan::Load(options.plan_path);
     drive->world = drive->plan->world;
@@ -117,6 +119,7 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   drive->duration = std::min(scenario.time_limit, options.seconds.value_or(scenario.time_limit));
   stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
   if (scenario.stack) parameters = parameters.Overridden(*scenario.stack);
+  drive->descriptor = parameters.visual.descriptor;
   if (parameters.localization == stack::LocalizationSource::kVisual) {
     parameters.localization = stack::LocalizationSource::kSimulatedPoseFixes;
   }
@@ -150,6 +153,7 @@ int RunMapBuild(const MapBuildOptions& options) {
   visual_localization::MapBuilderOptions builder_options;
   builder_options.survey_position_sigma = options.survey_position_sigma;
   builder_options.survey_rotation_sigma = options.survey_rotation_sigma_deg * M_PI / 180.0;
+  builder_options.features.descriptor = options.descriptor.value_or(drive->descriptor);
   visual_localization::MapBuilder builder(rig, builder_options);
   SurveyPoses survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
 
@@ -173,9 +177,11 @@ int RunMapBuild(const MapBuildOptions& options) {
                       std::to_string(stats.keyframes) + " keyframes");
   const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   nlohmann::json report = {{"plan", options.plan_path}, {"garden", map.garden}, {"seed", world.seed},
+                           {"descriptor", visual_localization::ToString(map.descriptor)},
                            {"frames_seen", stats.frames}, {"keyframes", stats.keyframes},
                            {"images_matched", stats.images_matched}, {"matches", stats.matches},
                            {"tracks", stats.tracks}, {"points", stats.points}, {"observations", stats.observations},
+                           {"outlier_observations_dropped", stats.outlier_observations},
                            {"mean_track_length", stats.mean_track_length},
                            {"reprojection_rmse_px", stats.reprojection_rmse_px},
                            {"seconds", {{"drive_and_render", drive_seconds - stats.seconds_features},

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "runner/world_setup.h"
+#include "trimbot/visual_localization/features.h"
 
 namespace trimbot::scenarios {
 
@@ -24,6 +25,8 @@ struct MapBuildOptions {
   std::optional<double> seconds;         // stop the drive early
   double survey_position_sigma = 0.02;   // m per axis
   double survey_rotation_sigma_deg = 0.5;
+  // Upright-SIFT or SIFT; default: the stack's (stack.yaml, with the scenario's stack section).
+  std::optional<visual_localization::Descriptor> descriptor;
 };
 
 int RunMapBuild(const MapBuildOptions& options);

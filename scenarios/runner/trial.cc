@@ -10,6 +10,7 @@
 #include "runner/closed_loop.h"
 #include "runner/controllers.h"
 #include "runner/prior_knowledge.h"
+#include "reports/localization_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
@@ -33,15 +34,15 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
 }
 
 void WriteTiming(const std::string& dir, double wall_seconds, double simulated_seconds, const stack::StackTimings& t) {
-  const double frames = std::max(1, t.visual_frames);
-  const nlohmann::json timing = {
+  nlohmann::json timing = {
       {"wall_seconds", wall_seconds},
       {"real_time_factor", wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0},
-      {"stack_seconds", {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}},
-      {"visual_localization_ms_per_frame",
-       {{"frames", t.visual_frames}, {"features", 1000 * t.visual_features / frames},
-        {"retrieval", 1000 * t.visual_retrieval / frames}, {"matching", 1000 * t.visual_matching / frames},
-        {"pose", 1000 * t.visual_pose / frames}}}};
+      {"stack_seconds", {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}}};
+  if (!t.visual_frames.empty()) {
+    timing["visual_localization"] = LocalizationTimeStats(t.visual_frames);
+    WriteLocalizationTimeHistogram(dir + "/localization_time.png", "visual localization time per frame, this trial",
+                                   t.visual_frames);
+  }
   WriteFileAtomically(dir + "/timing.json", timing.dump(2));
 }
 

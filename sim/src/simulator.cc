@@ -9,6 +9,7 @@
 #include "trimbot/common/random.h"
 #include "trimbot/sim/arm_controller.h"
 #include "trimbot/sim/base_controller.h"
+#include "trimbot/sim/camera_exposure.h"
 #include "trimbot/sim/imu_model.h"
 #include "trimbot/sim/ring_renderer.h"
 #include "trimbot/sim/wheel_encoder_model.h"
@@ -263,11 +264,13 @@ RingCapture Simulator::CaptureRing(bool with_ground_truth) {
   RingTruth& truth = capture.truth;
   for (int i = 0; i < rig_.size(); ++i) {
     RenderedView view = impl_->renderer->Render(i, with_ground_truth);
-    // Sensor noise, seeded per frame and camera so each image is reproducible on its own.
+    // The sensor's exposure control, then its read noise (amplified by the gain), seeded per frame
+    // and camera so each image is reproducible on its own.
+    const ExposureResult exposure = ApplyAutoExposure(view.rgb, parameters_.cameras.auto_exposure);
     if (parameters_.cameras.noise_sigma > 0.0) {
       cv::RNG rng(StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i)));
       cv::Mat noise(view.rgb.size(), CV_16SC3);
-      rng.fill(noise, cv::RNG::NORMAL, 0.0, parameters_.cameras.noise_sigma);
+      rng.fill(noise, cv::RNG::NORMAL, 0.0, parameters_.cameras.noise_sigma * exposure.gain);
       cv::Mat noisy;
       cv::add(view.rgb, noise, noisy, cv::noArray(), CV_8UC3);
       view.rgb = noisy;

@@ -82,6 +82,20 @@ struct RobotStack::Components {
   }
 };
 
+visual_localization::LocalizerOptions MakeLocalizerOptions(const VisualLocalizationParameters& v,
+                                                           const robot::CameraRig& rig) {
+  visual_localization::LocalizerOptions options;
+  options.features.max_features = v.features;
+  options.features.descriptor = v.descriptor;
+  options.keyframes = v.keyframes;
+  options.prior_radius = v.prior_radius;
+  options.pose.min_inliers = v.min_inliers;
+  if (v.left_cameras_only) {
+    for (const auto& pair : rig.StereoPairs()) options.cameras.push_back(pair.left);
+  }
+  return options;
+}
+
 RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed)
     : parameters_(parameters), components_(std::make_unique<Components>(files, parameters)) {
   SeedPlanner(seed);
@@ -107,18 +121,10 @@ void RobotStack::SetMap(const std::string& map_yaml) {
 }
 
 void RobotStack::SetVisualMap(const std::string& map_path) {
-  const VisualLocalizationParameters& v = parameters_.visual;
-  visual_localization::LocalizerOptions options;
-  options.features.max_features = v.features;
-  options.keyframes = v.keyframes;
-  options.prior_radius = v.prior_radius;
-  options.pose.min_inliers = v.min_inliers;
-  if (v.left_cameras_only) {
-    for (const auto& pair : components_->rig.StereoPairs()) options.cameras.push_back(pair.left);
-  }
   components_->localizer = std::make_unique<visual_localization::VisualLocalizer>(
-      visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(components_->rig)),
-      components_->rig, options);
+      visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(components_->rig),
+                                           parameters_.visual.descriptor),
+      components_->rig, MakeLocalizerOptions(parameters_.visual, components_->rig));
 }
 
 void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
@@ -190,12 +196,7 @@ void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
   localizer_busy_until_ = frame.stamp + latency;  // one frame at a time
   next_localization_ = frame.stamp + 1.0 / v.rate_hz;
   ++telemetry_.visual.attempts;
-  StackTimings& t = telemetry_.timings;
-  t.visual_features += result.timings.features;
-  t.visual_retrieval += result.timings.retrieval;
-  t.visual_matching += result.timings.matching;
-  t.visual_pose += result.timings.pose;
-  ++t.visual_frames;
+  telemetry_.timings.visual_frames.push_back(result.timings);
   if (!result.success) {
     ++telemetry_.visual.failures;
     return;

@@ -70,6 +70,11 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
   r.Number("latency_log_sigma", &p.latency_log_sigma, 0.0, 10.0);
   r.Number("latency_max", &p.latency_max, 1e-3, 60.0, "s");
   r.Integer("features", &p.features, 50, 100000);
+  if (r.Wanted("descriptor")) {
+    const std::string name = r.map().String("descriptor");
+    if (name != "upright_sift" && name != "sift") r.map().Fail("descriptor", "must be upright_sift or sift");
+    p.descriptor = visual_localization::DescriptorFromString(name);
+  }
   if (r.Wanted("cameras")) {
     const std::string cameras = r.map().String("cameras");
     if (cameras != "all" && cameras != "left") r.map().Fail("cameras", "must be all or left");

@@ -8,11 +8,21 @@
 
 namespace trimbot::visual_localization {
 
+const char* ToString(Descriptor descriptor) {
+  return descriptor == Descriptor::kUprightSift ? "upright_sift" : "sift";
+}
+
+Descriptor DescriptorFromString(const std::string& name) {
+  if (name == "upright_sift") return Descriptor::kUprightSift;
+  if (name == "sift") return Descriptor::kSift;
+  throw std::invalid_argument("unknown descriptor '" + name + "' (upright_sift, sift)");
+}
+
 Features ExtractFeatures(const cv::Mat& grey, const FeatureOptions& options) {
   if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument("ExtractFeatures: expects an 8-bit grey image");
   const cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
   Features f;
-  if (!options.upright) {
+  if (options.descriptor == Descriptor::kSift) {
     sift->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
     return f;
   }

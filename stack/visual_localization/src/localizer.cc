@@ -1,10 +1,12 @@
 #include "trimbot/visual_localization/localizer.h"
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 
@@ -42,6 +44,8 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
   cv::Mat raw(static_cast<int>(keyframe_points_.size()), words, CV_32F, cv::Scalar(0));
   std::vector<cv::DMatch> nearest;
   index_->words.match(map_.descriptors, nearest);
+  point_words_.resize(nearest.size());
+  for (std::size_t p = 0; p < nearest.size(); ++p) point_words_[p] = nearest[p].trainIdx;
   for (std::size_t k = 0; k < keyframe_points_.size(); ++k) {
     for (int p : keyframe_points_[k]) raw.at<float>(static_cast<int>(k), nearest[static_cast<std::size_t>(p)].trainIdx) += 1.0f;
   }
@@ -61,12 +65,9 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
 
 VisualLocalizer::~VisualLocalizer() = default;
 
-cv::Mat VisualLocalizer::WordHistogram(const cv::Mat& descriptors) const {
+cv::Mat VisualLocalizer::WordHistogram(const FrameFeatures& features) const {
   cv::Mat histogram(1, map_.vocabulary.rows, CV_32F, cv::Scalar(0));
-  if (descriptors.empty() || map_.vocabulary.empty()) return histogram;
-  std::vector<cv::DMatch> nearest;
-  index_->words.match(descriptors, nearest);
-  for (const auto& m : nearest) histogram.at<float>(0, m.trainIdx) += 1.0f;
+  for (const auto& words : features.words) histogram.at<float>(0, words[0]) += 1.0f;
   histogram = histogram.mul(idf_);
   const double norm = cv::norm(histogram);
   if (norm > 0) histogram /= norm;
@@ -74,16 +75,30 @@ cv::Mat VisualLocalizer::WordHistogram(const cv::Mat& descriptors) const {
 }
 
 VisualLocalizer::FrameFeatures VisualLocalizer::Extract(const messages::RingFrame& frame) const {
-  FrameFeatures out;
-  std::vector<cv::Mat> descriptors;
+  std::vector<const messages::Image*> images;
   for (const auto& image : frame.images) {
     if (image.camera_index < 0 || image.camera_index >= rig_.size() || image.data.empty()) continue;
     if (!options_.cameras.empty() &&
         std::find(options_.cameras.begin(), options_.cameras.end(), image.camera_index) == options_.cameras.end()) {
       continue;
     }
-    const ImageFeatures f = ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
-    out.camera.insert(out.camera.end(), f.bearings.size(), image.camera_index);
+    images.push_back(&image);
+  }
+  // The cameras' images are independent: extracted in parallel, each into its own slot, so the
+  // result does not depend on the number of threads.
+  std::vector<ImageFeatures> per_image(images.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(images.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const messages::Image& image = *images[static_cast<std::size_t>(i)];
+      per_image[static_cast<std::size_t>(i)] =
+          ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
+    }
+  });
+  FrameFeatures out;
+  std::vector<cv::Mat> descriptors;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const ImageFeatures& f = per_image[i];
+    out.camera.insert(out.camera.end(), f.bearings.size(), images[i]->camera_index);
     out.bearings.insert(out.bearings.end(), f.bearings.begin(), f.bearings.end());
     if (!f.descriptors.empty()) descriptors.push_back(f.descriptors);
   }
@@ -91,11 +106,32 @@ VisualLocalizer::FrameFeatures VisualLocalizer::Extract(const messages::RingFram
   return out;
 }
 
+void VisualLocalizer::AssignWords(FrameFeatures* features) const {
+  features->words.clear();
+  if (features->descriptors.empty() || map_.vocabulary.empty()) return;
+  // Blocks of rows in parallel, each into its own slots: the same words for any number of threads.
+  const int rows = features->descriptors.rows;
+  constexpr int kBlock = 256;
+  features->words.resize(static_cast<std::size_t>(rows));
+  cv::parallel_for_(cv::Range(0, (rows + kBlock - 1) / kBlock), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
+      const int begin = b * kBlock, end = std::min(rows, begin + kBlock);
+      std::vector<std::vector<cv::DMatch>> nearest;
+      cv::BFMatcher(cv::NORM_L2).knnMatch(features->descriptors.rowRange(begin, end), map_.vocabulary, nearest, 2);
+      for (int i = begin; i < end; ++i) {
+        const auto& pair = nearest[static_cast<std::size_t>(i - begin)];
+        features->words[static_cast<std::size_t>(i)] = {pair.at(0).trainIdx, pair.size() > 1 ? pair[1].trainIdx : pair[0].trainIdx};
+      }
+    }
+  });
+}
+
 std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
-                                           const std::optional<Eigen::Vector2d>& prior_position) const {
-  const bool use_prior = prior_position && options_.retrieval != Retrieval::kVocabulary;
-  const bool use_words = options_.retrieval != Retrieval::kPosePrior || !prior_position;
-  const cv::Mat query = use_words ? WordHistogram(features.descriptors) : cv::Mat();
+                                           const std::optional<Eigen::Vector2d>& prior_position,
+                                           Retrieval method) const {
+  const bool use_prior = prior_position && method != Retrieval::kVocabulary;
+  const bool use_words = method != Retrieval::kPosePrior || !prior_position;
+  const cv::Mat query = use_words ? WordHistogram(features) : cv::Mat();
   std::vector<std::pair<double, int>> ranked;  // (score, keyframe id); higher is better
   for (const auto& k : map_.keyframes) {
     const double distance = prior_position ? (k.T_map_base.translation().head<2>() - *prior_position).norm() : 0.0;
@@ -109,40 +145,69 @@ std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
   return ids;
 }
 
+std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features, const std::vector<int>& keyframes) const {
+  // The keyframes' points, by visual word: a query descriptor is compared with the points of its
+  // two nearest words only (as a vocabulary tree's direct index), not with every candidate.
+  std::vector<std::vector<int>> by_word(static_cast<std::size_t>(std::max(1, map_.vocabulary.rows)));
+  std::set<int> seen;
+  for (int id : keyframes) {
+    for (int p : keyframe_points_[static_cast<std::size_t>(id)]) {
+      if (seen.insert(p).second) by_word[static_cast<std::size_t>(point_words_[static_cast<std::size_t>(p)])].push_back(p);
+    }
+  }
+  const int n = features.descriptors.rows;
+  const int width = map_.descriptors.cols;
+  std::vector<int> best(static_cast<std::size_t>(n), -1);  // matched point per query, -1: none
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    for (int q = range.start; q < range.end; ++q) {
+      const float* query = features.descriptors.ptr<float>(q);
+      float first = std::numeric_limits<float>::max(), second = first;
+      int first_point = -1;
+      const auto& words = features.words[static_cast<std::size_t>(q)];
+      for (int w = 0; w < 2; ++w) {
+        if (w == 1 && words[1] == words[0]) break;
+        for (int p : by_word[static_cast<std::size_t>(words[static_cast<std::size_t>(w)])]) {
+          const float d = cv::normL2Sqr<float, float>(query, map_.descriptors.ptr<float>(p), width);
+          if (d < first) {
+            second = first;
+            first = d;
+            first_point = p;
+          } else if (d < second) {
+            second = d;
+          }
+        }
+      }
+      // Lowe's ratio test on distances (squared here).
+      if (first_point >= 0 && first <= options_.ratio * options_.ratio * second) best[static_cast<std::size_t>(q)] = first_point;
+    }
+  });
+  std::vector<Correspondence> correspondences;
+  for (int q = 0; q < n; ++q) {
+    const int p = best[static_cast<std::size_t>(q)];
+    if (p >= 0) correspondences.push_back({features.camera[static_cast<std::size_t>(q)], features.bearings[static_cast<std::size_t>(q)],
+                                           map_.points[static_cast<std::size_t>(p)]});
+  }
+  return correspondences;
+}
+
 LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
                                              const std::optional<Eigen::Vector2d>& prior_position) {
   LocalizationResult result;
   result.stamp = frame.stamp;
   auto start = Clock::now();
-  const FrameFeatures features = Extract(frame);
+  FrameFeatures features = Extract(frame);
   result.features = features.descriptors.rows;
   result.timings.features = Since(start);
   start = Clock::now();
-  result.retrieved = Retrieve(features, prior_position);
+  AssignWords(&features);
+  result.retrieved = Retrieve(features, prior_position, options_.retrieval);
   result.timings.retrieval = Since(start);
   if (features.descriptors.rows < options_.pose.min_inliers || result.retrieved.empty()) {
     result.failure = features.descriptors.rows < options_.pose.min_inliers ? "too few features" : "no keyframe retrieved";
     return result;
   }
   start = Clock::now();
-  std::set<int> candidate_set;
-  for (int id : result.retrieved) candidate_set.insert(keyframe_points_[static_cast<std::size_t>(id)].begin(),
-                                                       keyframe_points_[static_cast<std::size_t>(id)].end());
-  const std::vector<int> candidates(candidate_set.begin(), candidate_set.end());
-  std::vector<Correspondence> correspondences;
-  if (candidates.size() >= 2) {
-    cv::Mat points(static_cast<int>(candidates.size()), map_.descriptors.cols, CV_32F);
-    for (std::size_t i = 0; i < candidates.size(); ++i) map_.descriptors.row(candidates[i]).copyTo(points.row(static_cast<int>(i)));
-    cv::BFMatcher matcher(cv::NORM_L2);
-    std::vector<std::vector<cv::DMatch>> knn;
-    matcher.knnMatch(features.descriptors, points, knn, 2);
-    for (const auto& pair : knn) {
-      if (pair.size() < 2 || pair[0].distance > options_.ratio * pair[1].distance) continue;
-      const std::size_t q = static_cast<std::size_t>(pair[0].queryIdx);
-      correspondences.push_back({features.camera[q], features.bearings[q],
-                                 map_.points[static_cast<std::size_t>(candidates[static_cast<std::size_t>(pair[0].trainIdx)])]});
-    }
-  }
+  const std::vector<Correspondence> correspondences = Match(features, result.retrieved);
   result.matches = static_cast<int>(correspondences.size());
   result.timings.matching = Since(start);
   start = Clock::now();

@@ -225,9 +225,10 @@ struct PointTrack {
   Track track;
 };
 
-// Bundle adjustment of keyframe poses and points; returns the RMS reprojection error in pixels.
+// Bundle adjustment of keyframe poses and points; returns the RMS reprojection error in pixels and
+// each observation's error (px; points in order, each point's track in order) in `errors`.
 double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, std::vector<MappingKeyframe>& keyframes,
-              std::vector<PointTrack>& points) {
+              std::vector<PointTrack>& points, std::vector<double>* errors) {
   std::vector<std::array<double, 6>> poses(keyframes.size());
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const Eigen::AngleAxisd aa(keyframes[k].T_map_base.linear());
@@ -267,12 +268,33 @@ double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, std
   }
   // RMS of the pixel residuals (the cost functions are scaled by 1/sigma).
   double sum = 0.0;
+  errors->clear();
   for (const auto& [id, sigma] : blocks) {
     double residual[2];
     problem.EvaluateResidualBlock(id, false, nullptr, residual, nullptr);
-    sum += (residual[0] * residual[0] + residual[1] * residual[1]) * sigma * sigma;
+    const double squared = (residual[0] * residual[0] + residual[1] * residual[1]) * sigma * sigma;
+    sum += squared;
+    errors->push_back(std::sqrt(squared));
   }
   return blocks.empty() ? 0.0 : std::sqrt(sum / (2.0 * blocks.size()));
+}
+
+// Drops observations with an error above `max_error` (px; `errors` as Adjust gives them), then
+// points seen fewer than twice. Returns how many observations were dropped.
+int RemoveOutliers(const std::vector<double>& errors, double max_error, std::vector<PointTrack>& points) {
+  std::size_t next = 0;
+  int dropped = 0;
+  std::vector<PointTrack> kept;
+  for (auto& p : points) {
+    Track track;
+    for (const auto& r : p.track) {
+      if (errors[next++] <= max_error) track.push_back(r);
+    }
+    dropped += static_cast<int>(p.track.size() - track.size());
+    if (track.size() >= 2) kept.push_back({p.position, std::move(track)});
+  }
+  points = std::move(kept);
+  return dropped;
 }
 
 // The retrieval vocabulary: k-means over the map's descriptors (seeded: the same map, the same words).
@@ -327,12 +349,18 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
   }
   stats_.seconds_matching = Since(start);
   start = Clock::now();
-  stats_.reprojection_rmse_px = Adjust(rig_, options_, keyframes_, points);
+  // Adjust, drop the observations the adjusted map cannot explain (wrong matches, silhouettes that
+  // move with the viewpoint), adjust again.
+  std::vector<double> errors;
+  Adjust(rig_, options_, keyframes_, points, &errors);
+  stats_.outlier_observations = RemoveOutliers(errors, options_.max_reprojection_error, points);
+  stats_.reprojection_rmse_px = Adjust(rig_, options_, keyframes_, points, &errors);
   stats_.seconds_adjustment = Since(start);
 
   VisualMap map;
   map.garden = garden;
   map.rig_signature = RigSignature(rig_);
+  map.descriptor = options_.features.descriptor;
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     map.keyframes.push_back({static_cast<int>(k), keyframes_[k].stamp, keyframes_[k].T_map_base});
   }

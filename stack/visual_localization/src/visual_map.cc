@@ -71,7 +71,7 @@ void WriteSchema(sqlite3* db, const VisualMap& map) {
   Statement meta = Prepare(db, "INSERT INTO meta VALUES(?, ?)");
   for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
            {"format", "trimbot visual map"}, {"version", std::to_string(kMapFormatVersion)},
-           {"garden", map.garden}, {"rig_signature", map.rig_signature},
+           {"garden", map.garden}, {"rig_signature", map.rig_signature}, {"descriptor", ToString(map.descriptor)},
            {"descriptor_size", std::to_string(map.descriptors.cols)}}) {
     sqlite3_bind_text(meta.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(meta.get(), 2, value.c_str(), -1, SQLITE_TRANSIENT);
@@ -183,7 +183,8 @@ void VisualMap::Save(const std::string& path) const {
 }
 
 VisualMap VisualMap::Load(const std::string& path, const std::string& expected_garden,
-                          const std::string& expected_rig_signature) {
+                          const std::string& expected_rig_signature,
+                          std::optional<Descriptor> expected_descriptor) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "map file not found");
   sqlite3* raw = nullptr;
   if (sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
@@ -201,6 +202,7 @@ VisualMap VisualMap::Load(const std::string& path, const std::string& expected_g
     }
     map.garden = Meta(db.get(), "garden");
     map.rig_signature = Meta(db.get(), "rig_signature");
+    map.descriptor = DescriptorFromString(Meta(db.get(), "descriptor"));
     ReadRows(db.get(), std::stoi(Meta(db.get(), "descriptor_size")), &map);
   } catch (const SqlError& e) {
     throw InputError(path, std::string("not a valid map file (") + e.what() + ")");
@@ -213,6 +215,10 @@ VisualMap VisualMap::Load(const std::string& path, const std::string& expected_g
   if (!expected_rig_signature.empty() && map.rig_signature != expected_rig_signature) {
     throw InputError(path, "the map was made with another camera rig (signature " + map.rig_signature + ", this rig " +
                                expected_rig_signature + ")");
+  }
+  if (expected_descriptor && map.descriptor != *expected_descriptor) {
+    throw InputError(path, std::string("the map's descriptor is ") + ToString(map.descriptor) + ", the localizer's " +
+                               ToString(*expected_descriptor) + " (build the map with the same descriptor)");
   }
   return map;
 }

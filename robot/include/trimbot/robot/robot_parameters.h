@@ -21,9 +21,23 @@ struct WheelEncoderConfig {
   int ticks_per_revolution = 2048;
 };
 
+// The sensors' automatic exposure (AEC/AGC): per image, the exposure brings the mean grey level
+// of the metering window (the rows below `metering_top`, a fraction of the height: the ground, not
+// the sky) to `target_mean`; by exposure time first (up to `max_exposure_factor` times the
+// rendered daylight exposure, down to its inverse; no extra noise), then by analogue gain (up to
+// `max_gain`, which amplifies the read noise too).
+struct AutoExposure {
+  bool enabled = true;
+  double target_mean = 100.0;       // grey levels
+  double metering_top = 0.4;        // 0..1
+  double max_exposure_factor = 4.0;
+  double max_gain = 4.0;
+};
+
 struct CameraTiming {
   double rate_hz = 5.0;
   double noise_sigma = 2.0;
+  AutoExposure auto_exposure;
 };
 
 struct DriveLimits {

@@ -20,6 +20,7 @@
 #include "trimbot/messages/sensor_messages.h"
 #include "trimbot/robot/robot_files.h"
 #include "trimbot/stack/stack_parameters.h"
+#include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::stack {
 
@@ -32,9 +33,8 @@ struct StackTimings {
   double localization = 0.0;
   double navigation = 0.0;
   double perception = 0.0;
-  // Visual localization by stage (features, retrieval, matching, pose), and how many frames.
-  double visual_features = 0.0, visual_retrieval = 0.0, visual_matching = 0.0, visual_pose = 0.0;
-  int visual_frames = 0;
+  // Visual localization: each localized frame's time by stage (features, retrieval, matching, pose).
+  std::vector<visual_localization::LocalizationTimings> visual_frames;
 };
 
 // The stack's own visual localization, counted.
@@ -61,6 +61,11 @@ struct Telemetry {
   VisualLocalizationCounters visual;
   StackTimings timings;
 };
+
+// The localizer's options from the stack's parameters (one place: the stack and the offline
+// localization benchmarks use the same).
+visual_localization::LocalizerOptions MakeLocalizerOptions(const VisualLocalizationParameters& parameters,
+                                                           const robot::CameraRig& rig);
 
 class RobotStack {
  public:

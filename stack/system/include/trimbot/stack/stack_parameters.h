@@ -9,6 +9,7 @@
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
+#include "trimbot/visual_localization/features.h"
 
 namespace trimbot::stack {
 
@@ -24,9 +25,10 @@ struct VisualLocalizationParameters {
   double latency_median = 0.15;      // ... (deterministic mode) after a seeded log-normal latency
   double latency_log_sigma = 0.35;   //     like the real pipeline's (Figure 10 of D3.4)
   double latency_max = 1.5;          // s
-  int features = 1000;               // Upright-SIFT keypoints per camera image
+  int features = 1000;               // keypoints per camera image
+  visual_localization::Descriptor descriptor = visual_localization::Descriptor::kUprightSift;  // the map's too
   bool left_cameras_only = false;    // the left camera of each stereo pair (half the work)
-  int keyframes = 5;                 // retrieved keyframes whose points are matched
+  int keyframes = 20;                // retrieved keyframes whose points are matched
   double prior_radius = 3.0;         // m around the EKF's position
   int min_inliers = 12;
   double max_position_sigma = 0.5;   // m: with a larger EKF uncertainty the robot stops

@@ -17,9 +17,18 @@
 
 namespace trimbot::visual_localization {
 
+#include <string>
+
+// Which descriptor: Upright-SIFT (the robot's), or ordinary rotation-invariant SIFT (section
+// 2.1.1's comparison). A map records its descriptor; a localizer refuses a map of the other kind.
+enum class Descriptor { kUprightSift, kSift };
+const char* ToString(Descriptor descriptor);
+// "upright_sift" or "sift"; std::invalid_argument otherwise.
+Descriptor DescriptorFromString(const std::string& name);
+
 struct FeatureOptions {
   int max_features = 2000;   // strongest keypoints kept per image
-  bool upright = true;       // false: ordinary (rotation-invariant) SIFT, for comparison
+  Descriptor descriptor = Descriptor::kUprightSift;
 };
 
 struct Features {

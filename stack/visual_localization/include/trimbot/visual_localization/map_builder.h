@@ -9,7 +9,8 @@
 //   tracks      matches joined into tracks (union-find), inconsistent ones dropped
 //   points      triangulated from the survey poses (midpoint, checked by angle and depth)
 //   adjustment  Ceres: bearing reprojection errors (Huber) of every observation, keyframe poses
-//               held near the survey by priors (sigma from the survey)
+//               held near the survey by priors (sigma from the survey); observations with a large
+//               error afterwards are dropped and the map adjusted again
 //   vocabulary  k-means words over the map's descriptors, for retrieval
 #include <Eigen/Geometry>
 
@@ -34,6 +35,7 @@ struct MapBuilderOptions {
   double survey_position_sigma = 0.02;        // m, prior of each keyframe's position
   double survey_rotation_sigma = 0.5 * M_PI / 180;  // rad
   double pixel_sigma = 1.0;                   // px
+  double max_reprojection_error = 4.0;        // px: observations worse after adjustment are dropped
   double min_triangulation_angle = 1.0 * M_PI / 180;
   double max_depth = 25.0;                    // m
   int vocabulary_words = 256;
@@ -42,6 +44,7 @@ struct MapBuilderOptions {
 
 struct MapBuildStats {
   int frames = 0, keyframes = 0, images_matched = 0, matches = 0, tracks = 0, points = 0, observations = 0;
+  int outlier_observations = 0;                 // dropped after the first adjustment
   double mean_track_length = 0.0;
   double reprojection_rmse_px = 0.0;            // after adjustment, over all observations
   double seconds_features = 0.0, seconds_matching = 0.0, seconds_adjustment = 0.0, seconds_vocabulary = 0.0;

@@ -6,14 +6,16 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "trimbot/robot/camera_rig.h"
+#include "trimbot/visual_localization/features.h"
 
 namespace trimbot::visual_localization {
 
-constexpr int kMapFormatVersion = 1;
+constexpr int kMapFormatVersion = 2;  // 2: the descriptor kind is recorded
 
 struct MapKeyframe {
   int id = 0;
@@ -31,6 +33,7 @@ struct MapObservation {
 struct VisualMap {
   std::string garden;          // the garden the map was made in
   std::string rig_signature;   // RigSignature() of the calibration it was made with
+  Descriptor descriptor = Descriptor::kUprightSift;  // of the points and the vocabulary
   std::vector<MapKeyframe> keyframes;
   std::vector<Eigen::Vector3d> points;  // map frame; id = index
   cv::Mat descriptors;                  // CV_32F, one row per point
@@ -40,9 +43,11 @@ struct VisualMap {
   // Writes the map atomically. Throws std::runtime_error naming the file on failure.
   void Save(const std::string& path) const;
   // Reads a map; InputError naming the file when it is not a map, of another format version, or
-  // (when the expectations are not empty) made for another garden or camera rig.
+  // made for another garden or camera rig (when those expectations are not empty) or with another
+  // descriptor (when one is expected).
   static VisualMap Load(const std::string& path, const std::string& expected_garden = "",
-                        const std::string& expected_rig_signature = "");
+                        const std::string& expected_rig_signature = "",
+                        std::optional<Descriptor> expected_descriptor = std::nullopt);
 };
 
 // A short fingerprint of a rig's calibration (intrinsics, extrinsics at 0.1 mm / 0.01 px): a map
