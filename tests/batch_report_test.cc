@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "reports/batch_report.h"
+#include "reports/localization_timing.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "eval/trial_result.h"
@@ -394,6 +395,27 @@ TEST(ReadTumPositions, ReadsPositionsAndNamesTheBadLine) {
   const std::string short_line = testing::WriteTempFile("short.tum", "0.0 1.5 -2.0\n");
   EXPECT_THROW(ReadTumPositions(short_line), InputError);
   EXPECT_THROW(ReadTumPositions("/nonexistent/trajectory.tum"), InputError);
+}
+
+// Per-frame stage times: median and p90 of each stage and of the total, the frames round-tripped
+// through the JSON (0.1 ms), and the Figure 10 histogram drawn.
+TEST(LocalizationTiming, StatsPerStageAndTheHistogram) {
+  std::vector<visual_localization::LocalizationTimings> frames;
+  for (int i = 1; i <= 10; ++i) frames.push_back({0.010 * i, 0.001, 0.002 * i, 0.0005});
+  const nlohmann::json stats = LocalizationTimeStats(frames);
+  EXPECT_EQ(stats["frames"].get<int>(), 10);
+  EXPECT_NEAR(stats["features"]["median_ms"].get<double>(), 55.0, 1e-9);   // between 50 and 60
+  EXPECT_NEAR(stats["features"]["p90_ms"].get<double>(), 91.0, 1e-9);      // 90 + 0.1 * 10
+  EXPECT_NEAR(stats["total"]["median_ms"].get<double>(), 12.0 * 5.5 + 1.5, 1e-9);  // frame i: 12 i + 1.5 ms
+  EXPECT_NEAR(stats["total"]["max_ms"].get<double>(), 121.5, 1e-9);
+  const auto back = LocalizationTimesFromJson(stats);
+  ASSERT_EQ(back.size(), frames.size());
+  EXPECT_NEAR(back[9].matching, 0.020, 1e-6);
+  const std::string path = testing::TempDir("localization_timing") + "/localization_time.png";
+  WriteLocalizationTimeHistogram(path, "test", frames);
+  const cv::Mat image = cv::imread(path);
+  ASSERT_FALSE(image.empty());
+  EXPECT_GT(image.cols, 600);
 }
 
 }  // namespace

@@ -141,6 +141,19 @@ TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   EXPECT_LT(worst_angle, 3.0);
 }
 
+// The stack's default localization is visual: a scenario that neither names a map nor chooses
+// another source is refused, naming the file.
+TEST(Scenario, VisualLocalizationWithoutAMapIsAnInputError) {
+  const Scenario s = Scenario::Load(SmokeVariant("no_map.yaml", "stack: \\{localization: none\\}[^\\n]*\\n", ""));
+  try {
+    StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no_map.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("names no visual_map"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scenario, FixtureSettingsWithoutTheFixtureAreAnInputError) {
   const Scenario s = Scenario::Load(SmokeVariant("unused_fixes.yaml", "time_limit: 60.0",
                                                  "time_limit: 60.0\nsimulated_pose_fixes: {availability: 0.5}"));
@@ -189,8 +202,7 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
 TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
   const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
   const std::string out = testing::TempDir("trial_faults");
-  Scenario clean = Scenario::Load(SmokeVariant("fixes.yaml", "time_limit: 60.0",
-                                               "time_limit: 60.0\nstack: {localization: simulated_pose_fixes}"));
+  Scenario clean = Scenario::Load(SmokeVariant("fixes.yaml", "localization: none", "localization: simulated_pose_fixes"));
   WritePriorMap(PriorMap(clean, paths), out + "/map");
 
   Scenario faulty = clean;

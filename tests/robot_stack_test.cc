@@ -63,7 +63,9 @@ class UnicyclePlant {
 };
 
 TEST(RobotStack, BuildsFromTheRobotFilesAndEstimatesAStraightDrive) {
-  RobotStack stack(Files(), StackParameters::Load(Files().stack_parameters), 1);
+  StackParameters parameters = StackParameters::Load(Files().stack_parameters);
+  parameters.localization = LocalizationSource::kNone;
+  RobotStack stack(Files(), parameters, 1);
   stack.SetInitialPose(0.0, {1.0, 2.0, 0.3});
   UnicyclePlant plant({1.0, 2.0, 0.3});
   while (plant.time() < 10.0) {
@@ -97,6 +99,7 @@ std::string WriteMap() {
 
 TEST(RobotStack, DrivesAKinematicBaseAroundAnObstacleToItsGoal) {
   StackParameters parameters = StackParameters::Load(Files().stack_parameters);
+  parameters.localization = LocalizationSource::kNone;  // dead reckoning on perfect sensors
   RobotStack stack(Files(), parameters, 3);
   stack.SetInitialPose(0.0, {0.0, 0.0, 0.0});
   stack.SetMap(WriteMap());
@@ -170,7 +173,7 @@ TEST(StackParameters, BadFilesNameTheFileAndTheKey) {
       {"inf.yaml", "cruise_speed: 0.25", "cruise_speed: .inf", "key 'navigation.follower.cruise_speed': must be a finite"},
       {"range.yaml", "cruise_speed: 0.25", "cruise_speed: 2.0", "key 'navigation.follower.cruise_speed': must be in [0.01, 0.6]"},
       {"negative.yaml", "iterations: 3000", "iterations: -5", "key 'navigation.planner.iterations': must be in"},
-      {"source.yaml", "localization: none", "localization: gps", "unknown source 'gps'"},
+      {"source.yaml", "localization: visual", "localization: gps", "unknown source 'gps'"},
       {"type.yaml", "enabled: false", "enabled: maybe", "key 'perception.local_fusion.enabled': expected a boolean"},
   };
   for (const Case& c : cases) {

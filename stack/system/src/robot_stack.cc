@@ -129,6 +129,9 @@ void RobotStack::SetVisualMap(const std::string& map_path) {
 
 void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
   if (!components_->navigator) throw std::logic_error("RobotStack::SetGoals: no map (call SetMap first)");
+  if (parameters_.localization == LocalizationSource::kVisual && !components_->localizer) {
+    throw std::logic_error("RobotStack::SetGoals: localization is visual but no visual map was given (SetVisualMap)");
+  }
   components_->navigator->SetGoals(goals);
   teleop_.reset();
 }

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <set>
+#include <stdexcept>
 
 namespace trimbot::visual_localization {
 namespace {
@@ -108,7 +109,11 @@ VisualLocalizer::FrameFeatures VisualLocalizer::Extract(const messages::RingFram
 
 void VisualLocalizer::AssignWords(FrameFeatures* features) const {
   features->words.clear();
-  if (features->descriptors.empty() || map_.vocabulary.empty()) return;
+  if (map_.vocabulary.empty()) {  // a map without points: one empty word
+    features->words.assign(static_cast<std::size_t>(features->descriptors.rows), {0, 0});
+    return;
+  }
+  if (features->descriptors.empty()) return;
   // Blocks of rows in parallel, each into its own slots: the same words for any number of threads.
   const int rows = features->descriptors.rows;
   constexpr int kBlock = 256;
@@ -156,6 +161,9 @@ std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features
     }
   }
   const int n = features.descriptors.rows;
+  if (static_cast<int>(features.words.size()) != n) {
+    throw std::logic_error("VisualLocalizer::Match: the features' words are not assigned (call AssignWords)");
+  }
   const int width = map_.descriptors.cols;
   std::vector<int> best(static_cast<std::size_t>(n), -1);  // matched point per query, -1: none
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {

@@ -85,7 +85,8 @@ class RobotStack {
   // The visual localization map (trimbot map build); needed with localization: visual. Throws
   // InputError naming the file if it is not a map or was made for another camera rig.
   void SetVisualMap(const std::string& map_path);
-  // Goals in the map frame, visited in order; navigation starts with the next update.
+  // Goals in the map frame, visited in order; navigation starts with the next update. Needs the
+  // prior map, and with localization: visual the visual map (std::logic_error otherwise).
   void SetGoals(const std::vector<Eigen::Vector2d>& goals);
   // Drive by hand: the command passes through to the base (navigation stays idle); the stack
   // still estimates its pose and runs perception.
