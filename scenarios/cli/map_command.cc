@@ -4,6 +4,7 @@
 
 #include "runner/localization_eval.h"
 #include "runner/mapping.h"
+#include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -35,6 +36,9 @@ void AddEvalCommand(CLI::App* map, const std::string& name, const std::string& h
       ->check(CLI::Range(0.1, 1.0));
   command->add_option("--prior-sigma", options->prior_sigma, "m: noise of the position prior (truth + noise)")
       ->check(CLI::Range(0.0, 100.0));
+  if (name == "retrieval-eval") {
+    command->add_option("--top", options->retrieval_top, "keyframes retrieved per query frame")->check(CLI::Range(1, 1000));
+  }
   command->add_option("--set", options->stack_overrides, "override a stack.yaml key, e.g. visual_localization.cameras=left");
   command->callback([=, &data_root, &exit_code]() {
     options->paths = {data_root};
@@ -66,10 +70,13 @@ void AddMapCommands(CLI::App& app, const std::string& data_root, int& exit_code)
   build->add_option("--survey-rotation-sigma-deg", options->survey_rotation_sigma_deg, "survey rotation noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
   auto descriptor = std::make_shared<std::string>();
-  build->add_option("--descriptor", *descriptor, "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)")
-      ->check(CLI::IsMember({"upright_sift", "sift"}));
+  build->add_option("--descriptor", *descriptor, "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)");
   build->callback([options, seed, seconds, seed_option, seconds_option, descriptor, &data_root, &exit_code]() {
-    if (!descriptor->empty()) options->descriptor = visual_localization::DescriptorFromString(*descriptor);
+    try {
+      if (!descriptor->empty()) options->descriptor = visual_localization::DescriptorFromString(*descriptor);
+    } catch (const std::invalid_argument& e) {
+      throw InputError("--descriptor", e.what());
+    }
     options->paths = {data_root};
     if (seed_option->count() > 0) options->seed = *seed;
     if (seconds_option->count() > 0) options->seconds = *seconds;

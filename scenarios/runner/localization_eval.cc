@@ -215,7 +215,7 @@ int RunRetrievalEval(const LocalizationEvalOptions& options) {
       if (cameras_seen.empty() || cameras_seen.back() != c) cameras_seen.push_back(c);
     }
     for (std::size_t m = 0; m < methods.size(); ++m) {
-      for (int keyframe : localizer->Retrieve(features, position, methods[m].first)) {
+      for (int keyframe : localizer->Retrieve(features, position, methods[m].first, options.retrieval_top)) {
         // Geometrically verified: inliers of the ring's pose from this keyframe's points alone.
         const auto correspondences = localizer->Match(features, {keyframe});
         const auto pose = visual_localization::EstimateRigPose(correspondences, localizer->T_base_camera(),

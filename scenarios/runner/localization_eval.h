@@ -5,7 +5,7 @@
 // compared with the simulator's ground truth.
 //   trimbot map bench           per frame: fix or not, errors, time by stage (median, p90); the
 //                               processing-time histogram (D3.4 Figure 10)
-//   trimbot map retrieval-eval  D3.4 Table 4: the share of the top-5 retrieved keyframes with at
+//   trimbot map retrieval-eval  D3.4 Table 4: the share of the top-5 (--top) retrieved keyframes with at
 //                               least 50 / 100 / 200 geometrically verified matches, per image and
 //                               per rig, for retrieval by vocabulary, by pose prior and combined
 #include <cstdint>
@@ -34,6 +34,7 @@ struct LocalizationEvalOptions {
   QueryDriveOptions drive;
   std::vector<std::string> stack_overrides;  // key=value under stack.yaml, e.g. visual_localization.cameras=left
   double prior_sigma = 0.2;                  // m: the pose prior is the true position plus this noise
+  int retrieval_top = 5;                     // retrieval-eval: keyframes retrieved per query (Table 4: 5)
   std::string out_dir;
   ProjectPaths paths;
 };

@@ -170,6 +170,10 @@ int RunMapBuild(const MapBuildOptions& options) {
 
   visual_localization::MapBuildStats stats;
   const visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
+  if (map.points.empty()) {
+    throw std::runtime_error(options.plan_path + ": the mapping drive gave no map points (" + std::to_string(stats.keyframes) +
+                             " keyframes; too short, or nothing textured in view)");
+  }
   map.Save(options.out_dir + "/map.sqlite");
   const garden::OccupancyMap objects = garden::MakeOccupancyMap(simulator.garden(), 0.05, 1.0);
   WriteMapTopView(options.out_dir + "/map_top_view.png", map, objects,

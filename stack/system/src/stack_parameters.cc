@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 namespace trimbot::stack {
@@ -71,9 +72,11 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
   r.Number("latency_max", &p.latency_max, 1e-3, 60.0, "s");
   r.Integer("features", &p.features, 50, 100000);
   if (r.Wanted("descriptor")) {
-    const std::string name = r.map().String("descriptor");
-    if (name != "upright_sift" && name != "sift") r.map().Fail("descriptor", "must be upright_sift or sift");
-    p.descriptor = visual_localization::DescriptorFromString(name);
+    try {
+      p.descriptor = visual_localization::DescriptorFromString(r.map().String("descriptor"));
+    } catch (const std::invalid_argument& e) {
+      r.map().Fail("descriptor", e.what());
+    }
   }
   if (r.Wanted("cameras")) {
     const std::string cameras = r.map().String("cameras");

@@ -4,6 +4,7 @@
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -17,16 +18,31 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+// The two nearest visual words of each descriptor: brute force over the vocabulary (a few hundred
+// words: exact and fast enough), blocks of rows in parallel, each into its own slots - the same
+// words for any number of threads.
+std::vector<std::array<int, 2>> TwoNearestWords(const cv::Mat& descriptors, const cv::Mat& vocabulary) {
+  const int rows = descriptors.rows;
+  std::vector<std::array<int, 2>> words(static_cast<std::size_t>(rows));
+  constexpr int kBlock = 256;
+  cv::parallel_for_(cv::Range(0, (rows + kBlock - 1) / kBlock), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) {
+      const int begin = b * kBlock, end = std::min(rows, begin + kBlock);
+      std::vector<std::vector<cv::DMatch>> nearest;
+      cv::BFMatcher(cv::NORM_L2).knnMatch(descriptors.rowRange(begin, end), vocabulary, nearest, 2);
+      for (int i = begin; i < end; ++i) {
+        const auto& pair = nearest[static_cast<std::size_t>(i - begin)];
+        words[static_cast<std::size_t>(i)] = {pair.at(0).trainIdx, pair.size() > 1 ? pair[1].trainIdx : pair[0].trainIdx};
+      }
+    }
+  });
+  return words;
+}
+
 }  // namespace
 
-// Nearest visual word of a descriptor: a brute-force matcher over the vocabulary (a few hundred
-// words: exact and fast enough).
-struct VisualLocalizer::Index {
-  cv::BFMatcher words{cv::NORM_L2};
-};
-
 VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, const LocalizerOptions& options)
-    : map_(std::move(map)), rig_(rig), options_(options), index_(std::make_unique<Index>()) {
+    : map_(std::move(map)), rig_(rig), options_(options) {
   for (const auto& camera : rig_.cameras()) T_base_camera_.push_back(camera.T_base_camera);
   int max_id = -1;
   for (const auto& k : map_.keyframes) max_id = std::max(max_id, k.id);
@@ -39,16 +55,12 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
     points.erase(std::unique(points.begin(), points.end()), points.end());
   }
   if (map_.vocabulary.empty()) return;
-  index_->words.add(map_.vocabulary);
   // tf-idf: a word seen by few keyframes says more about the place.
   const int words = map_.vocabulary.rows;
   cv::Mat raw(static_cast<int>(keyframe_points_.size()), words, CV_32F, cv::Scalar(0));
-  std::vector<cv::DMatch> nearest;
-  index_->words.match(map_.descriptors, nearest);
-  point_words_.resize(nearest.size());
-  for (std::size_t p = 0; p < nearest.size(); ++p) point_words_[p] = nearest[p].trainIdx;
+  for (const auto& nearest : TwoNearestWords(map_.descriptors, map_.vocabulary)) point_words_.push_back(nearest[0]);
   for (std::size_t k = 0; k < keyframe_points_.size(); ++k) {
-    for (int p : keyframe_points_[k]) raw.at<float>(static_cast<int>(k), nearest[static_cast<std::size_t>(p)].trainIdx) += 1.0f;
+    for (int p : keyframe_points_[k]) raw.at<float>(static_cast<int>(k), point_words_[static_cast<std::size_t>(p)]) += 1.0f;
   }
   idf_ = cv::Mat(1, words, CV_32F);
   for (int w = 0; w < words; ++w) {
@@ -64,9 +76,8 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
   }
 }
 
-VisualLocalizer::~VisualLocalizer() = default;
-
 cv::Mat VisualLocalizer::WordHistogram(const FrameFeatures& features) const {
+  if (map_.vocabulary.empty()) return cv::Mat();  // no words: retrieval by position alone
   cv::Mat histogram(1, map_.vocabulary.rows, CV_32F, cv::Scalar(0));
   for (const auto& words : features.words) histogram.at<float>(0, words[0]) += 1.0f;
   histogram = histogram.mul(idf_);
@@ -113,27 +124,12 @@ void VisualLocalizer::AssignWords(FrameFeatures* features) const {
     features->words.assign(static_cast<std::size_t>(features->descriptors.rows), {0, 0});
     return;
   }
-  if (features->descriptors.empty()) return;
-  // Blocks of rows in parallel, each into its own slots: the same words for any number of threads.
-  const int rows = features->descriptors.rows;
-  constexpr int kBlock = 256;
-  features->words.resize(static_cast<std::size_t>(rows));
-  cv::parallel_for_(cv::Range(0, (rows + kBlock - 1) / kBlock), [&](const cv::Range& range) {
-    for (int b = range.start; b < range.end; ++b) {
-      const int begin = b * kBlock, end = std::min(rows, begin + kBlock);
-      std::vector<std::vector<cv::DMatch>> nearest;
-      cv::BFMatcher(cv::NORM_L2).knnMatch(features->descriptors.rowRange(begin, end), map_.vocabulary, nearest, 2);
-      for (int i = begin; i < end; ++i) {
-        const auto& pair = nearest[static_cast<std::size_t>(i - begin)];
-        features->words[static_cast<std::size_t>(i)] = {pair.at(0).trainIdx, pair.size() > 1 ? pair[1].trainIdx : pair[0].trainIdx};
-      }
-    }
-  });
+  features->words = TwoNearestWords(features->descriptors, map_.vocabulary);
 }
 
 std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
                                            const std::optional<Eigen::Vector2d>& prior_position,
-                                           Retrieval method) const {
+                                           Retrieval method, int count) const {
   const bool use_prior = prior_position && method != Retrieval::kVocabulary;
   const bool use_words = method != Retrieval::kPosePrior || !prior_position;
   const cv::Mat query = use_words ? WordHistogram(features) : cv::Mat();
@@ -146,7 +142,7 @@ std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
   }
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<int> ids;
-  for (std::size_t i = 0; i < ranked.size() && static_cast<int>(i) < options_.keyframes; ++i) ids.push_back(ranked[i].second);
+  for (std::size_t i = 0; i < ranked.size() && static_cast<int>(i) < count; ++i) ids.push_back(ranked[i].second);
   return ids;
 }
 
@@ -185,8 +181,11 @@ std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features
           }
         }
       }
-      // Lowe's ratio test on distances (squared here).
-      if (first_point >= 0 && first <= options_.ratio * options_.ratio * second) best[static_cast<std::size_t>(q)] = first_point;
+      // Lowe's ratio test on distances (squared here); a lone candidate cannot pass it.
+      if (first_point >= 0 && second < std::numeric_limits<float>::max() &&
+          first <= options_.ratio * options_.ratio * second) {
+        best[static_cast<std::size_t>(q)] = first_point;
+      }
     }
   });
   std::vector<Correspondence> correspondences;
@@ -208,7 +207,7 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   result.timings.features = Since(start);
   start = Clock::now();
   AssignWords(&features);
-  result.retrieved = Retrieve(features, prior_position, options_.retrieval);
+  result.retrieved = Retrieve(features, prior_position, options_.retrieval, options_.keyframes);
   result.timings.retrieval = Since(start);
   if (features.descriptors.rows < options_.pose.min_inliers || result.retrieved.empty()) {
     result.failure = features.descriptors.rows < options_.pose.min_inliers ? "too few features" : "no keyframe retrieved";

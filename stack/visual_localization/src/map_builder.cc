@@ -225,10 +225,11 @@ struct PointTrack {
   Track track;
 };
 
-// Bundle adjustment of keyframe poses and points; returns the RMS reprojection error in pixels and
-// each observation's error (px; points in order, each point's track in order) in `errors`.
-double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, std::vector<MappingKeyframe>& keyframes,
-              std::vector<PointTrack>& points, std::vector<double>* errors) {
+// Bundle adjustment of keyframe poses and points, the poses held near `survey` (one per keyframe);
+// returns the RMS reprojection error in pixels and each observation's error (px; points in order,
+// each point's track in order) in `errors`.
+double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, const std::vector<Eigen::Isometry3d>& survey,
+              std::vector<MappingKeyframe>& keyframes, std::vector<PointTrack>& points, std::vector<double>* errors) {
   std::vector<std::array<double, 6>> poses(keyframes.size());
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const Eigen::AngleAxisd aa(keyframes[k].T_map_base.linear());
@@ -251,7 +252,7 @@ double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, std
   }
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     auto* prior = new ceres::AutoDiffCostFunction<PosePrior, 6, 6>(
-        new PosePrior{keyframes[k].T_map_base.linear().transpose(), keyframes[k].T_map_base.translation(),
+        new PosePrior{survey[k].linear().transpose(), survey[k].translation(),
                       options.survey_rotation_sigma, options.survey_position_sigma});
     problem.AddResidualBlock(prior, nullptr, poses[k].data());
   }
@@ -351,10 +352,12 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
   start = Clock::now();
   // Adjust, drop the observations the adjusted map cannot explain (wrong matches, silhouettes that
   // move with the viewpoint), adjust again.
+  std::vector<Eigen::Isometry3d> survey;  // both passes are held to the survey, not the first pass
+  for (const auto& keyframe : keyframes_) survey.push_back(keyframe.T_map_base);
   std::vector<double> errors;
-  Adjust(rig_, options_, keyframes_, points, &errors);
+  Adjust(rig_, options_, survey, keyframes_, points, &errors);
   stats_.outlier_observations = RemoveOutliers(errors, options_.max_reprojection_error, points);
-  stats_.reprojection_rmse_px = Adjust(rig_, options_, keyframes_, points, &errors);
+  stats_.reprojection_rmse_px = Adjust(rig_, options_, survey, keyframes_, points, &errors);
   stats_.seconds_adjustment = Since(start);
 
   VisualMap map;

@@ -204,6 +204,8 @@ VisualMap VisualMap::Load(const std::string& path, const std::string& expected_g
     map.rig_signature = Meta(db.get(), "rig_signature");
     map.descriptor = DescriptorFromString(Meta(db.get(), "descriptor"));
     ReadRows(db.get(), std::stoi(Meta(db.get(), "descriptor_size")), &map);
+    if (map.points.empty()) throw SqlError("the map has no points");
+    if (map.vocabulary.empty()) throw SqlError("the map has points but no vocabulary");
   } catch (const SqlError& e) {
     throw InputError(path, std::string("not a valid map file (") + e.what() + ")");
   } catch (const std::logic_error& e) {

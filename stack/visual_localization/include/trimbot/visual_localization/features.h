@@ -10,14 +10,13 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include <string>
 #include <vector>
 
 #include "trimbot/messages/sensor_messages.h"
 #include "trimbot/robot/camera_rig.h"
 
 namespace trimbot::visual_localization {
-
-#include <string>
 
 // Which descriptor: Upright-SIFT (the robot's), or ordinary rotation-invariant SIFT (section
 // 2.1.1's comparison). A map records its descriptor; a localizer refuses a map of the other kind.

@@ -55,7 +55,6 @@ struct LocalizationResult {
 class VisualLocalizer {
  public:
   VisualLocalizer(VisualMap map, const robot::CameraRig& rig, const LocalizerOptions& options);
-  ~VisualLocalizer();
 
   // Features of a frame (per camera, bearings in the calibration's camera frames).
   struct FrameFeatures {
@@ -67,10 +66,10 @@ class VisualLocalizer {
   FrameFeatures Extract(const messages::RingFrame& frame) const;
   // The features' visual words (needed by Retrieve and Match).
   void AssignWords(FrameFeatures* features) const;
-  // The options' `keyframes` ids ranked by `method` for these features (and the prior's position,
-  // if any), best first.
+  // The best `count` keyframe ids by `method` for these features (and the prior's position, if
+  // any), best first.
   std::vector<int> Retrieve(const FrameFeatures& features, const std::optional<Eigen::Vector2d>& prior_position,
-                            Retrieval method) const;
+                            Retrieval method, int count) const;
   // 2D-3D correspondences of the features with the points these keyframes observe: each feature
   // against the points of its two nearest words, ratio test.
   std::vector<Correspondence> Match(const FrameFeatures& features, const std::vector<int>& keyframes) const;
@@ -92,8 +91,6 @@ class VisualLocalizer {
   std::vector<int> point_words_;                   // per map point: its nearest visual word
   cv::Mat keyframe_histograms_;                    // one tf-idf row per keyframe, L2-normalized
   cv::Mat idf_;
-  struct Index;
-  std::unique_ptr<Index> index_;
 };
 
 }  // namespace trimbot::visual_localization

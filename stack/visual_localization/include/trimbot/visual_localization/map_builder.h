@@ -46,7 +46,7 @@ struct MapBuildStats {
   int frames = 0, keyframes = 0, images_matched = 0, matches = 0, tracks = 0, points = 0, observations = 0;
   int outlier_observations = 0;                 // dropped after the first adjustment
   double mean_track_length = 0.0;
-  double reprojection_rmse_px = 0.0;            // after adjustment, over all observations
+  double reprojection_rmse_px = 0.0;            // after the second adjustment, over the observations kept
   double seconds_features = 0.0, seconds_matching = 0.0, seconds_adjustment = 0.0, seconds_vocabulary = 0.0;
 };
 
