@@ -16,7 +16,7 @@
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/robot/camera_rig.h"
-#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/visual_localization/localizer.h"
 #include "trimbot/visual_localization/visual_map.h"
 
@@ -113,9 +113,7 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
   const auto& errors = stats["keyframes_against_ground_truth"];
   EXPECT_LT(errors["adjusted_position_error_mean_m"].get<double>(), errors["survey_position_error_mean_m"].get<double>())
       << "bundle adjustment brings the keyframes closer to the truth than the survey";
-  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
-  const robot::CameraRig rig = robot::CameraRig::LoadKalibr(
-      files.camchain, robot::RobotDescription::Load(files.urdf).FramePose(robot::RobotFrames::CameraOptical(0)));
+  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   const VisualMap map = VisualMap::Load(options.out_dir + "/map.sqlite", "test_lawn", RigSignature(rig));
   EXPECT_EQ(static_cast<int>(map.points.size()), stats["points"].get<int>());
   EXPECT_GT(map.vocabulary.rows, 10);
@@ -128,9 +126,7 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
 TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const std::string dir = testing::TempDir("map_for_queries");
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
-  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
-  const robot::CameraRig rig = robot::CameraRig::LoadKalibr(
-      files.camchain, robot::RobotDescription::Load(files.urdf).FramePose(robot::RobotFrames::CameraOptical(0)));
+  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   const scenarios::DrivePlan plan = scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drives/lawn_loop.yaml"));
   scenarios::WorldSetup world = plan.world;
   world.seed = 77;

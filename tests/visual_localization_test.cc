@@ -10,7 +10,7 @@
 
 #include "sim_test_support.h"
 #include "trimbot/robot/camera_rig.h"
-#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/visual_localization/features.h"
 #include "trimbot/visual_localization/rig_pose.h"
 
@@ -18,10 +18,7 @@ namespace trimbot::visual_localization {
 namespace {
 
 std::vector<Eigen::Isometry3d> RingExtrinsics() {
-  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
-  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
-  const robot::CameraRig rig =
-      robot::CameraRig::LoadKalibr(files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
+  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   std::vector<Eigen::Isometry3d> extrinsics;
   for (const auto& camera : rig.cameras()) extrinsics.push_back(camera.T_base_camera);
   return extrinsics;

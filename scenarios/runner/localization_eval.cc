@@ -11,6 +11,7 @@
 #include <memory>
 #include <random>
 
+#include "eval/pose_errors.h"
 #include "eval/trial_result.h"
 #include "reports/localization_timing.h"
 #include "runner/closed_loop.h"
@@ -19,7 +20,7 @@
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/overrides.h"
 #include "trimbot/common/random.h"
-#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/stack/robot_stack.h"
 #include "trimbot/visual_localization/localizer.h"
 
@@ -98,13 +99,7 @@ std::unique_ptr<VisualLocalizer> MakeLocalizer(const LocalizationEvalOptions& op
     ApplyOverrides(root, ParseOverrides(options.stack_overrides), "--set");
     parameters = parameters.Overridden(YamlMap(root, "--set", ""));
   }
-  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
-  const robot::CameraRig rig =
-      robot::CameraRig::LoadKalibr(files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
-  return std::make_unique<VisualLocalizer>(
-      visual_localization::VisualMap::Load(options.map_path, "", visual_localization::RigSignature(rig),
-                                           parameters.visual.descriptor),
-      rig, stack::MakeLocalizerOptions(parameters.visual, rig));
+  return stack::MakeVisualLocalizer(options.map_path, parameters.visual, robot::LoadCameraRig(files));
 }
 
 // The true position plus seeded noise: what the EKF would offer as the retrieval prior.
@@ -120,8 +115,6 @@ class NoisyPrior {
   std::normal_distribution<double> normal_{0.0, 1.0};
   double sigma_;
 };
-
-double YawOf(const Eigen::Isometry3d& T) { return std::atan2(T.linear()(1, 0), T.linear()(0, 0)); }
 
 nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDrive& drive) {
   return {{"map", options.map_path}, {"plan", options.drive.plan_path}, {"seed", drive.world.seed},
@@ -154,8 +147,9 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
     ++fixes;
     const double error = (result.T_map_base.translation() - query.T_map_base.translation()).head<2>().norm();
     position_errors.push_back(error);
-    heading_errors.push_back(std::abs(std::remainder(YawOf(result.T_map_base) - YawOf(query.T_map_base), 2 * M_PI)) *
-                             180.0 / M_PI);
+    heading_errors.push_back(
+        std::abs(AngleDifference(stack::ToPose2(result.T_map_base).yaw, stack::ToPose2(query.T_map_base).yaw)) * 180.0 /
+        M_PI);
     within_25cm += error <= 0.25 ? 1 : 0;
   }
   const double n = std::max<double>(1, drive.frames.size());

@@ -24,7 +24,7 @@
 #include "trimbot/common/random.h"
 #include "trimbot/common/rotation.h"
 #include "trimbot/garden/garden_tools.h"
-#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/visual_localization/map_builder.h"
 
 namespace trimbot::scenarios {
@@ -103,7 +103,8 @@ struct MappingDrive {
 
 std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   auto drive = std::make_unique<MappingDrive>();
-  drive->descriptor = stack::StackParameters::Load(options.paths.robot_files().stack_parameters).visual.descriptor;
+  stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
+  drive->descriptor = parameters.visual.descriptor;
   if (!YamlMap::LoadFile(options.plan_path).Has("goals")) {
     drive->plan = DrivePlan::Load(options.plan_path);
     drive->world = drive->plan->world;
@@ -117,7 +118,6 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   drive->world = scenario.world;
   drive->world.seed = options.seed.value_or(scenario.world.seed + kMappingSeedOffset);
   drive->duration = std::min(scenario.time_limit, options.seconds.value_or(scenario.time_limit));
-  stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
   if (scenario.stack) parameters = parameters.Overridden(*scenario.stack);
   drive->descriptor = parameters.visual.descriptor;
   if (parameters.localization == stack::LocalizationSource::kVisual) {
@@ -146,10 +146,7 @@ int RunMapBuild(const MapBuildOptions& options) {
   sim::Simulator simulator(config);
 
   // The map is made with the calibration the robot's stack reads (robot/), as the real one was.
-  const robot::RobotFiles files = options.paths.robot_files();
-  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
-  const robot::CameraRig rig =
-      robot::CameraRig::LoadKalibr(files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
+  const robot::CameraRig rig = robot::LoadCameraRig(options.paths.robot_files());
   visual_localization::MapBuilderOptions builder_options;
   builder_options.survey_position_sigma = options.survey_position_sigma;
   builder_options.survey_rotation_sigma = options.survey_rotation_sigma_deg * M_PI / 180.0;

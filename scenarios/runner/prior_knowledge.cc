@@ -11,7 +11,7 @@
 #include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/camera_rig.h"
-#include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 
 namespace trimbot::scenarios {
 
@@ -74,9 +74,7 @@ std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths
   const robot::RobotFiles files = paths.robot_files();
   const CalibrationError& error = scenario.calibration_error;
   if (!error.any()) return files.camchain;
-  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
-  const robot::CameraRig truth = robot::CameraRig::LoadKalibr(
-      files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)));
+  const robot::CameraRig truth = robot::LoadCameraRig(files);
   Rng rng = MakeRng(seed, "calibration_error");
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<robot::CameraCalibration> cameras = truth.cameras();

@@ -82,8 +82,9 @@ struct RobotStack::Components {
   }
 };
 
-visual_localization::LocalizerOptions MakeLocalizerOptions(const VisualLocalizationParameters& v,
-                                                           const robot::CameraRig& rig) {
+std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const std::string& map_path,
+                                                                         const VisualLocalizationParameters& v,
+                                                                         const robot::CameraRig& rig) {
   visual_localization::LocalizerOptions options;
   options.features.max_features = v.features;
   options.features.descriptor = v.descriptor;
@@ -93,13 +94,14 @@ visual_localization::LocalizerOptions MakeLocalizerOptions(const VisualLocalizat
   if (v.left_cameras_only) {
     for (const auto& pair : rig.StereoPairs()) options.cameras.push_back(pair.left);
   }
-  return options;
+  return std::make_unique<visual_localization::VisualLocalizer>(
+      visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(rig), v.descriptor), rig,
+      options);
 }
 
 RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed)
     : parameters_(parameters), components_(std::make_unique<Components>(files, parameters)) {
   SeedPlanner(seed);
-  seed_ = seed;
   components_->latency_rng = MakeRng(seed, "visual_localization_latency");
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
@@ -121,10 +123,7 @@ void RobotStack::SetMap(const std::string& map_yaml) {
 }
 
 void RobotStack::SetVisualMap(const std::string& map_path) {
-  components_->localizer = std::make_unique<visual_localization::VisualLocalizer>(
-      visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(components_->rig),
-                                           parameters_.visual.descriptor),
-      components_->rig, MakeLocalizerOptions(parameters_.visual, components_->rig));
+  components_->localizer = MakeVisualLocalizer(map_path, parameters_.visual, components_->rig);
 }
 
 void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {

@@ -3,6 +3,8 @@
 // the robot software from them (each reads only what it needs). Nothing else configures either.
 #include <string>
 
+#include "trimbot/robot/camera_rig.h"
+
 namespace trimbot::robot {
 
 struct RobotFiles {
@@ -15,5 +17,9 @@ struct RobotFiles {
   // calibration/nominal_camchain.yaml, config/robot_parameters.yaml, config/stack.yaml.
   static RobotFiles InFolder(const std::string& robot_dir);
 };
+
+// The ring as these files describe it: the camchain's cameras, placed on base_link by cam0's frame
+// in the URDF. Throws InputError naming the file that is missing or malformed.
+CameraRig LoadCameraRig(const RobotFiles& files);
 
 }  // namespace trimbot::robot

@@ -62,10 +62,12 @@ struct Telemetry {
   StackTimings timings;
 };
 
-// The localizer's options from the stack's parameters (one place: the stack and the offline
-// localization benchmarks use the same).
-visual_localization::LocalizerOptions MakeLocalizerOptions(const VisualLocalizationParameters& parameters,
-                                                           const robot::CameraRig& rig);
+// The stack's visual localizer for `rig` against the map file, configured by `parameters` (one
+// place: the stack and the offline localization benchmarks use the same). Throws InputError naming
+// the file if it is not a map or was made for another rig or descriptor.
+std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const std::string& map_path,
+                                                                         const VisualLocalizationParameters& parameters,
+                                                                         const robot::CameraRig& rig);
 
 class RobotStack {
  public:
@@ -130,7 +132,6 @@ class RobotStack {
   std::vector<PendingFix> pending_fixes_;   // visual fixes still "being computed"
   double localizer_busy_until_ = -1.0;
   double next_localization_ = 0.0;
-  std::uint64_t seed_ = 0;
 };
 
 }  // namespace trimbot::stack
