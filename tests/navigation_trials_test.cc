@@ -141,29 +141,28 @@ TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   EXPECT_LT(worst_angle, 3.0);
 }
 
-// The stack's default localization is visual: a scenario that neither names a map nor chooses
-// another source is refused, naming the file.
-TEST(Scenario, VisualLocalizationWithoutAMapIsAnInputError) {
-  const Scenario s = Scenario::Load(SmokeVariant("no_map.yaml", "stack: \\{localization: none\\}[^\\n]*\\n", ""));
+// The stack's parameters for `s` are refused with an InputError naming `file` and the `problem`.
+void ExpectStackParametersError(const Scenario& s, const std::string& file, const std::string& problem) {
   try {
     StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no_map.yaml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("names no visual_map"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
   }
+}
+
+// The stack's default localization is visual: a scenario that neither names a map nor chooses
+// another source is refused, naming the file.
+TEST(Scenario, VisualLocalizationWithoutAMapIsAnInputError) {
+  const Scenario s = Scenario::Load(SmokeVariant("no_map.yaml", "stack: \\{localization: none\\}[^\\n]*\\n", ""));
+  ExpectStackParametersError(s, "no_map.yaml", "names no visual_map");
 }
 
 TEST(Scenario, FixtureSettingsWithoutTheFixtureAreAnInputError) {
   const Scenario s = Scenario::Load(SmokeVariant("unused_fixes.yaml", "time_limit: 60.0",
                                                  "time_limit: 60.0\nsimulated_pose_fixes: {availability: 0.5}"));
-  try {
-    StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
-    ADD_FAILURE() << "accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("unused_fixes.yaml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("localization is 'none'"), std::string::npos) << e.what();
-  }
+  ExpectStackParametersError(s, "unused_fixes.yaml", "localization is 'none'");
 }
 
 TEST(Scenario, BadFilesNameTheFileLineAndKey) {
