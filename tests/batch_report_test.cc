@@ -12,6 +12,7 @@
 
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
+#include "reports/run_timing.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "eval/trial_result.h"
@@ -416,6 +417,55 @@ TEST(LocalizationTiming, StatsPerStageAndTheHistogram) {
   const cv::Mat image = cv::imread(path);
   ASSERT_FALSE(image.empty());
   EXPECT_GT(image.cols, 600);
+}
+
+// The run's time by stage: every stage's seconds as measured, "other" the rest of the wall time,
+// per-item figures where counted; the JSON reads back; trials add up; the chart is written.
+TEST(RunTiming, StagesAccountForTheWallTimeAndAddUpOverTrials) {
+  sim::SimulatorTimings sim;
+  sim.physics = 2.0;
+  sim.physics_steps = 4000;
+  sim.render_draw = 10.0;
+  sim.camera_images = 200;
+  sim.exposure_noise = 0.5;
+  stack::StackTimings stack;
+  stack.ekf = 0.25;
+  stack.visual_localization = 4.5;
+  stack.visual_frames = {{0.06, 0.005, 0.02, 0.005}, {0.07, 0.005, 0.02, 0.005}};
+  stack.planning = 0.5;
+  const RunTiming run = MakeRunTiming(25.0, 10.0, sim, &stack, 1.0, 0.25);
+  double sum = 0.0;
+  const StageTime* other = nullptr;
+  const StageTime* draw = nullptr;
+  const StageTime* features = nullptr;
+  for (const auto& s : run.stages) {
+    sum += s.seconds;
+    if (s.name == "other") other = &s;
+    if (s.name == "render_draw") draw = &s;
+    if (s.name == "visual_features") features = &s;
+  }
+  ASSERT_NE(other, nullptr);
+  ASSERT_NE(draw, nullptr);
+  ASSERT_NE(features, nullptr);
+  EXPECT_EQ(run.stages.back().name, "other");
+  EXPECT_NEAR(sum, 25.0, 1e-9);
+  EXPECT_NEAR(features->seconds, 0.13, 1e-12);
+  EXPECT_EQ(features->count, 2);
+  const nlohmann::json json = ToJson(run);
+  EXPECT_NEAR(json["real_time_factor"].get<double>(), 0.4, 1e-12);
+  EXPECT_NEAR(json["stages"][1]["ms_per"].get<double>(), 50.0, 1e-9);  // render_draw per camera image
+  const RunTiming back = RunTimingFromJson(json);
+  ASSERT_EQ(back.stages.size(), run.stages.size());
+  const RunTiming two = Sum({run, back});
+  EXPECT_NEAR(two.wall_seconds, 50.0, 1e-9);
+  EXPECT_NEAR(two.stages[1].seconds, 20.0, 1e-9);
+  EXPECT_EQ(two.stages[1].count, 400);
+  EXPECT_EQ(two.stages.back().name, "other");
+  EXPECT_THROW(RunTimingFromJson(nlohmann::json{{"wall_seconds", 1.0}}), std::runtime_error);
+  const std::string png = testing::TempDir("run_timing") + "/timing.png";
+  WriteRunTimingChart(png, "test", run);
+  EXPECT_FALSE(cv::imread(png).empty());
+  EXPECT_NE(FormatRunTiming(run).find("render_draw"), std::string::npos);
 }
 
 }  // namespace

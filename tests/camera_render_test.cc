@@ -13,6 +13,7 @@
 #include <map>
 
 #include "sim_test_support.h"
+#include "trimbot/sim/camera_noise.h"
 
 namespace trimbot::sim {
 namespace {
@@ -178,6 +179,68 @@ Recording Record(std::uint64_t seed, const std::string& name) {
     }
   }
   return recording;
+}
+
+// What the stack asks for is what is rendered: only the named cameras, at the asked resolution
+// (the same view as at another resolution), their ground truth in their own slots.
+TEST(RingRequest, RendersOnlyTheNamedCamerasAtTheAskedResolution) {
+  SimulatorConfig config = TestConfig(testing::TestLawn(), "ring_request", true);
+  config.cameras_on_schedule = false;
+  config.resolution_scale = 0.5;
+  Simulator simulator(config);
+  messages::RingRequest request;
+  request.cameras = {1, 6};
+  request.resolution_scale = 0.25;
+  const RingCapture quarter = simulator.CaptureRing(request, true);
+  ASSERT_EQ(quarter.frame.images.size(), 2u);
+  EXPECT_EQ(quarter.frame.images[0].camera_index, 1);
+  EXPECT_EQ(quarter.frame.images[1].camera_index, 6);
+  EXPECT_EQ(quarter.frame.images[1].width, 188);
+  EXPECT_EQ(quarter.frame.images[1].height, 120);
+  ASSERT_EQ(quarter.truth.views.size(), static_cast<std::size_t>(simulator.rig().size()));
+  EXPECT_TRUE(quarter.truth.views[0].depth.empty());
+  EXPECT_EQ(quarter.truth.views[6].depth.rows, 120);
+  EXPECT_EQ(quarter.truth.T_map_camera.size(), static_cast<std::size_t>(simulator.rig().size()));
+
+  // The whole ring at the configured (half) resolution, shrunk to a quarter: the same picture.
+  const RingCapture half = simulator.CaptureRing(false);
+  ASSERT_EQ(half.frame.images.size(), static_cast<std::size_t>(simulator.rig().size()));
+  const auto& big = half.frame.images[6];
+  const auto& small = quarter.frame.images[1];
+  cv::Mat shrunk;
+  cv::resize(cv::Mat(big.height, big.width, CV_8UC3, const_cast<uint8_t*>(big.data.data())), shrunk,
+             cv::Size(small.width, small.height), 0, 0, cv::INTER_AREA);
+  cv::Mat difference;
+  cv::absdiff(shrunk, cv::Mat(small.height, small.width, CV_8UC3, const_cast<uint8_t*>(small.data.data())), difference);
+  EXPECT_LT(cv::mean(difference)[0], 12.0) << "grey levels: the quarter-size view is the half-size view, smaller";
+
+  EXPECT_TRUE(messages::Merge({{0, 2}, 0.5}, {}).cameras == std::vector<int>({0, 2}));
+  const messages::RingRequest both = messages::Merge({{0, 2, 4}, 0.5}, {{1, 2}, 1.0});
+  EXPECT_EQ(both.cameras, std::vector<int>({0, 1, 2, 4}));
+  EXPECT_EQ(both.resolution_scale, 1.0);
+}
+
+// Read noise from the bank: zero mean, the asked sigma, the same image seed the same noise, another
+// seed other noise; saturates instead of wrapping.
+TEST(ReadNoise, HasTheAskedSigmaAndIsReproducible) {
+  const ReadNoise noise(5);
+  cv::Mat a(240, 376, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::Mat b = a.clone(), c = a.clone();
+  noise.Apply(a, 2.0, 11);
+  noise.Apply(b, 2.0, 11);
+  noise.Apply(c, 2.0, 12);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(a, c, cv::NORM_L1), 0.0);
+  cv::Scalar mean, sigma;
+  cv::meanStdDev(a.reshape(1), mean, sigma);
+  EXPECT_NEAR(mean[0], 128.0, 0.05);
+  EXPECT_NEAR(sigma[0], 2.0, 0.1);  // rounding to grey levels adds 1/12 to the variance
+  cv::Mat white(10, 10, CV_8UC3, cv::Scalar(255, 255, 255));
+  noise.Apply(white, 50.0, 3);
+  double lowest = 0.0;
+  cv::minMaxLoc(white.reshape(1), &lowest);
+  EXPECT_LT(lowest, 255.0);
+  EXPECT_GT(cv::mean(white)[0], 200.0) << "saturated at 255, not wrapped to dark";
 }
 
 TEST(Determinism, SameSeedSameBytes) {

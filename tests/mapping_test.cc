@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
@@ -17,6 +18,8 @@
 #include "trimbot/common/input_error.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_files.h"
+#include "trimbot/stack/robot_stack.h"
+#include "trimbot/stack/stack_parameters.h"
 #include "trimbot/visual_localization/localizer.h"
 #include "trimbot/visual_localization/visual_map.h"
 
@@ -164,6 +167,29 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
     EXPECT_LT(yaw_error, 1.0);
     EXPECT_GT(result.planar_covariance(0, 0), 0.0);
   }
+  // The stack on this map asks the ring for what its localizer uses: the left camera of each pair
+  // at stack.yaml's image_scale, when a localization is due, and nothing while it is busy.
+  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
+  const stack::StackParameters parameters = stack::StackParameters::Load(files.stack_parameters);
+  ASSERT_EQ(parameters.localization, stack::LocalizationSource::kVisual);
+  stack::RobotStack robot(files, parameters, 1);
+  robot.SetInitialPose(0.0, {truth.translation().x(), truth.translation().y(), 0.0});
+  robot.SetVisualMap(dir + "/map.sqlite");
+  const messages::RingRequest request = robot.RingRequestAt(0.2);
+  std::vector<int> left;
+  for (const auto& pair : rig.StereoPairs()) left.push_back(pair.left);
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(request.cameras, left);
+  EXPECT_EQ(request.resolution_scale, parameters.visual.image_scale);
+  sim::RingCapture asked = simulator.CaptureRing(request, false);
+  asked.frame.stamp = 0.2;
+  for (auto& image : asked.frame.images) image.stamp = 0.2;
+  ASSERT_EQ(asked.frame.images.size(), left.size());
+  robot.Add(asked.frame);
+  EXPECT_EQ(robot.telemetry().visual.attempts, 1);
+  EXPECT_TRUE(robot.RingRequestAt(0.4).empty()) << "busy or above rate_hz: no frame wanted";
+  EXPECT_FALSE(robot.RingRequestAt(0.2 + 1.0 / parameters.visual.rate_hz + parameters.visual.latency_max).empty());
+
   // A frame without images: no fix, a reason.
   messages::RingFrame empty;
   VisualLocalizer localizer(VisualMap::Load(dir + "/map.sqlite"), rig, {});

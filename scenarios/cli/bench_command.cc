@@ -2,9 +2,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include "runner/closed_loop.h"
 #include "runner/controllers.h"
@@ -19,10 +23,11 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4) {
+sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4, bool shadows = true) {
   WorldSetup world;
   world.garden = options.garden;
   world.seed = 7;
+  world.conditions.shadows = shadows;
   sim::SimulatorConfig config =
       MakeSimulatorConfig(options.paths, world, std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
   config.render_cameras = cameras;
@@ -31,28 +36,96 @@ sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double sc
   return config;
 }
 
-nlohmann::json RenderCost(const BenchOptions& options, double scale, int msaa) {
-  sim::Simulator simulator(Config(options, true, scale, msaa));
-  simulator.CaptureRing(false);  // warm-up: shader compilation, texture upload
-  auto start = Clock::now();
-  for (int i = 0; i < options.frames; ++i) simulator.CaptureRing(false);
+// One way of rendering the ring: which cameras, resolution, anti-aliasing, shadows, and whether
+// two renderers (two OpenGL contexts, each on its own thread) share the cameras.
+struct RenderVariant {
+  std::string name;
+  double scale = 1.0;
+  int msaa = 4;
+  bool shadows = true;
+  bool left_only = false;  // the left camera of each pair (what localization asks for)
+  bool two_threads = false;
+};
+
+messages::RingRequest RequestFor(const sim::Simulator& simulator, const RenderVariant& v) {
+  messages::RingRequest request = simulator.WholeRing();
+  if (v.left_only) {
+    request.cameras.clear();
+    for (const auto& pair : simulator.rig().StereoPairs()) request.cameras.push_back(pair.left);
+    std::sort(request.cameras.begin(), request.cameras.end());
+  }
+  return request;
+}
+
+// Milliseconds per ring frame by stage (differences of the simulator's stage clocks).
+nlohmann::json StageMs(const sim::SimulatorTimings& before, const sim::SimulatorTimings& after, int frames) {
+  const auto ms = [&](double a, double b) { return 1000.0 * (b - a) / frames; };
+  return {{"draw", ms(before.render_draw, after.render_draw)},
+          {"readback", ms(before.render_readback, after.render_readback)},
+          {"distortion", ms(before.distortion, after.distortion)},
+          {"exposure_noise", ms(before.exposure_noise, after.exposure_noise)}};
+}
+
+nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
+  const int renderers = v.two_threads ? 2 : 1;
+  std::vector<std::unique_ptr<sim::Simulator>> simulators;
+  std::vector<messages::RingRequest> requests;
+  for (int r = 0; r < renderers; ++r) {
+    simulators.push_back(std::make_unique<sim::Simulator>(Config(options, true, v.scale, v.msaa, v.shadows)));
+    messages::RingRequest request = RequestFor(*simulators.back(), v);
+    if (v.two_threads) {  // each renderer takes every other camera
+      std::vector<int> mine;
+      for (std::size_t i = static_cast<std::size_t>(r); i < request.cameras.size(); i += 2) mine.push_back(request.cameras[i]);
+      request.cameras = mine;
+    }
+    requests.push_back(request);
+    simulators.back()->CaptureRing(request, false);  // warm-up: shader compilation, texture upload
+  }
+  const sim::SimulatorTimings before = simulators[0]->timings();
+  const auto start = Clock::now();
+  const auto render = [&](int r) {
+    for (int i = 0; i < options.frames; ++i) simulators[static_cast<std::size_t>(r)]->CaptureRing(requests[static_cast<std::size_t>(r)], false);
+  };
+  if (v.two_threads) {
+    std::thread second(render, 1);
+    render(0);
+    second.join();
+  } else {
+    render(0);
+  }
   const double ring_ms = 1000.0 * Seconds(start) / options.frames;
-  start = Clock::now();
-  for (int i = 0; i < options.frames; ++i) simulator.CaptureRing(true);
-  const double ring_truth_ms = 1000.0 * Seconds(start) / options.frames;
-  const auto& model = simulator.rig().camera(0).intrinsics;
-  nlohmann::json out;
-  out["width"] = static_cast<int>(std::lround(model.width * scale));
-  out["height"] = static_cast<int>(std::lround(model.height * scale));
-  out["ms_per_camera"] = ring_ms / simulator.rig().size();
-  out["ms_per_ring"] = ring_ms;
-  out["ms_per_camera_with_depth_and_labels"] = ring_truth_ms / simulator.rig().size();
-  out["ms_per_ring_with_depth_and_labels"] = ring_truth_ms;
-  out["msaa_samples"] = msaa;
-  std::printf("  %4dx%-4d msaa %d  %7.1f ms/camera  %7.1f ms/ring  | with depth+labels %7.1f ms/camera %7.1f ms/ring\n",
-              out["width"].get<int>(), out["height"].get<int>(), msaa, ring_ms / simulator.rig().size(), ring_ms,
-              ring_truth_ms / simulator.rig().size(), ring_truth_ms);
+  std::size_t cameras = 0;
+  for (const auto& request : requests) cameras += request.cameras.size();
+  const auto& model = simulators[0]->rig().camera(0).intrinsics;
+  nlohmann::json out = {{"variant", v.name},
+                        {"width", static_cast<int>(std::lround(model.width * v.scale))},
+                        {"height", static_cast<int>(std::lround(model.height * v.scale))},
+                        {"cameras", cameras},
+                        {"msaa_samples", v.msaa},
+                        {"shadows", v.shadows},
+                        {"renderers", renderers},
+                        {"ms_per_ring", ring_ms},
+                        {"ms_per_camera", ring_ms / static_cast<double>(cameras)}};
+  if (!v.two_threads) out["stages_ms_per_ring"] = StageMs(before, simulators[0]->timings(), options.frames);
+  std::printf("  %-34s %2zu x %4dx%-4d  %7.1f ms/ring  %6.1f ms/camera", v.name.c_str(), cameras, out["width"].get<int>(),
+              out["height"].get<int>(), ring_ms, ring_ms / static_cast<double>(cameras));
+  if (!v.two_threads) {
+    const auto& st = out["stages_ms_per_ring"];
+    std::printf("  (draw %.1f, readback %.1f, distortion %.1f, exposure+noise %.1f)", st["draw"].get<double>(),
+                st["readback"].get<double>(), st["distortion"].get<double>(), st["exposure_noise"].get<double>());
+  }
+  std::printf("\n");
   return out;
+}
+
+nlohmann::json GroundTruthCost(const BenchOptions& options) {
+  sim::Simulator simulator(Config(options, true, 1.0));
+  simulator.CaptureRing(true);
+  const auto start = Clock::now();
+  for (int i = 0; i < options.frames; ++i) simulator.CaptureRing(true);
+  const double ms = 1000.0 * Seconds(start) / options.frames;
+  std::printf("  full ring with depth and labels (ground truth): %.1f ms/ring\n", ms);
+  return {{"ms_per_ring", ms}};
 }
 
 // Real-time factor of the loop driving an arc open-loop for `seconds` (no robot software).
@@ -73,11 +146,23 @@ double DriveRealTimeFactor(const BenchOptions& options, bool cameras, double sca
 int RunBench(const BenchOptions& options) {
   nlohmann::json report;
   report["garden"] = options.garden;
-  std::printf("rendering (%s, %d ring frames each, OSMesa/llvmpipe):\n", options.garden.c_str(), options.frames);
-  report["render_full_resolution"] = RenderCost(options, 1.0, 4);
-  report["render_half_resolution"] = RenderCost(options, 0.5, 4);
-  report["render_full_resolution_no_msaa"] = RenderCost(options, 1.0, 0);
-  report["render_half_resolution_no_msaa"] = RenderCost(options, 0.5, 0);
+  std::printf("rendering (%s, %d ring frames each, OSMesa/llvmpipe, %u hardware threads):\n", options.garden.c_str(),
+              options.frames, std::thread::hardware_concurrency());
+  const std::vector<RenderVariant> variants = {
+      {"full ring, msaa 4, shadows", 1.0, 4, true, false, false},
+      {"full ring, msaa 0, shadows", 1.0, 0, true, false, false},
+      {"full ring, msaa 4, no shadows", 1.0, 4, false, false, false},
+      {"full ring, msaa 0, no shadows", 1.0, 0, false, false, false},
+      {"full ring, msaa 4, two renderers", 1.0, 4, true, false, true},
+      {"half resolution, msaa 4", 0.5, 4, true, false, false},
+      {"half resolution, msaa 0", 0.5, 0, true, false, false},
+      {"localization: 5 left, half, msaa 4", 0.5, 4, true, true, false},
+      {"localization: 5 left, half, msaa 0", 0.5, 0, true, true, false},
+  };
+  nlohmann::json render = nlohmann::json::array();
+  for (const auto& variant : variants) render.push_back(RenderCost(options, variant));
+  report["render"] = render;
+  report["render_full_ring_with_ground_truth"] = GroundTruthCost(options);
 
   {
     // Physics alone: 8000 steps of the loop without cameras.

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "reports/run_log.h"
+#include "reports/run_timing.h"
 #include "runner/closed_loop.h"
 #include "runner/controllers.h"
 #include "runner/drive_plan.h"
@@ -87,7 +88,6 @@ int RunDrive(const DriveOptions& options) {
   const sim::SimulatorConfig config = PlantFor(options, plan, plan.world);
   const auto setup_start = Clock::now();
   sim::Simulator simulator(config);
-  const double setup_seconds = std::chrono::duration<double>(Clock::now() - setup_start).count();
   WriteFileAtomically(out + "/calibration/camchain.yaml", simulator.rig().ToKalibrYaml());
 
   // The stack listens (wheel odometry, EKF) from the plan's start; the plan drives.
@@ -111,22 +111,30 @@ int RunDrive(const DriveOptions& options) {
     failure = e.what();
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
+  const auto report_start = Clock::now();
   log.Write();
-  const double wall = std::chrono::duration<double>(Clock::now() - run_start).count();
   nlohmann::json summary = Summary(options, plan, config, simulator, log, listener.telemetry());
   summary["status"] = failure.empty() ? "completed" : "failed";
   if (!failure.empty()) summary["error"] = failure;
   WriteFileAtomically(out + "/summary.json", summary.dump(2) + "\n");
-  const double ms_per_frame = simulator.rendered_frames() > 0 ? 1000.0 * simulator.render_seconds() / simulator.rendered_frames() : 0.0;
-  const nlohmann::json timing = {{"wall_seconds", wall}, {"setup_seconds", setup_seconds},
-                                 {"real_time_factor", simulator.time() / wall}, {"ms_per_ring_frame", ms_per_frame}};
-  WriteFileAtomically(out + "/timing.json", timing.dump(2) + "\n");
+  const auto seconds = [](Clock::time_point from) { return std::chrono::duration<double>(Clock::now() - from).count(); };
+  const double wall = seconds(setup_start);
+  const sim::SimulatorTimings sim_timing = simulator.timings();
+  const RunTiming timing = MakeRunTiming(wall, simulator.time(), sim_timing, &listener.telemetry().timings,
+                                         std::chrono::duration<double>(run_start - setup_start).count(),
+                                         seconds(report_start));
+  const double render_seconds = sim_timing.render_draw + sim_timing.render_readback + sim_timing.distortion +
+                                sim_timing.exposure_noise + sim_timing.ground_truth;
+  const double ms_per_frame = sim_timing.ring_frames > 0 ? 1000.0 * render_seconds / sim_timing.ring_frames : 0.0;
+  WriteFileAtomically(out + "/timing.json", ToJson(timing).dump(2) + "\n");
+  WriteRunTimingChart(out + "/timing.png", "where the drive's time went", timing);
 
   if (!options.quiet) {
     std::printf("drive %s: %.1f s simulated in %.1f s (real-time factor %.2f), %ld ring frames (%.0f ms each), "
                 "odometry end error %.3f m\noutputs in %s\n",
                 failure.empty() ? "completed" : "FAILED", simulator.time(), wall, simulator.time() / wall, log.frames(),
                 ms_per_frame, summary["wheel_odometry_end_error_m"].get<double>(), out.c_str());
+    std::printf("%s", FormatRunTiming(timing).c_str());
   }
   if (!failure.empty()) {
     std::fprintf(stderr, "error: %s\n", failure.c_str());

@@ -32,8 +32,11 @@ void AddEvalCommand(CLI::App* map, const std::string& name, const std::string& h
   auto seconds = std::make_shared<double>(0.0);
   auto* seconds_option = command->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
                              ->check(CLI::PositiveNumber);
-  command->add_option("--resolution-scale", options->drive.resolution_scale, "render at this fraction of 752x480")
+  command->add_option("--resolution-scale", options->drive.resolution_scale,
+                      "render at this fraction of 752x480 (default: the stack's visual_localization.image_scale)")
       ->check(CLI::Range(0.1, 1.0));
+  command->add_option("--msaa", options->drive.msaa_samples, "the renderer's anti-aliasing samples (0: none)")
+      ->check(CLI::Range(0, 16));
   command->add_option("--prior-sigma", options->prior_sigma, "m: noise of the position prior (truth + noise)")
       ->check(CLI::Range(0.0, 100.0));
   if (name == "retrieval-eval") {

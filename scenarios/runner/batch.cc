@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -21,6 +22,7 @@
 
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
+#include "reports/run_timing.h"
 #include "runner/prior_knowledge.h"
 #include "runner/scenario.h"
 #include "runner/trial.h"
@@ -118,11 +120,12 @@ std::string OneLine(const TrialResult& r) {
 }
 
 // Wall-clock figures, kept out of summary.json so that the same scenario and seed give the same
-// summary, byte for byte.
-void WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
+// summary, byte for byte. Returns the trials' stage times summed (none without trial timings).
+std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
   json trials = json::array();
   double total = 0.0;
   std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
+  std::vector<RunTiming> runs;
   for (const auto& r : results) {
     trials.push_back({{"index", r.index}, {"seed", r.seed}, {"wall_seconds", r.wall_seconds}});
     total += r.wall_seconds;
@@ -130,6 +133,11 @@ void WriteTiming(const std::string& out, const std::vector<TrialResult>& results
     if (!fs::exists(trial_timing)) continue;
     std::ifstream file(trial_timing);
     const json timing = json::parse(file, nullptr, false);
+    try {
+      runs.push_back(RunTimingFromJson(timing));
+    } catch (const std::exception& e) {
+      // A trial folder from an older version: its stages are left out of the sum, not guessed.
+    }
     if (timing.is_object() && timing.contains("visual_localization")) {
       const auto trial_frames = LocalizationTimesFromJson(timing["visual_localization"]);
       frames.insert(frames.end(), trial_frames.begin(), trial_frames.end());
@@ -143,7 +151,15 @@ void WriteTiming(const std::string& out, const std::vector<TrialResult>& results
                                    "visual localization time per frame, " + std::to_string(results.size()) + " trials",
                                    frames);
   }
+  std::optional<RunTiming> summed;
+  if (!runs.empty()) {
+    summed = Sum(runs);
+    report["stages_summed_over_trials"] = ToJson(*summed);
+    WriteRunTimingChart(out + "/timing.png",
+                        "where the time went, summed over " + std::to_string(runs.size()) + " trials", *summed);
+  }
   WriteFileAtomically(out + "/timing.json", report.dump(2));
+  return summed;
 }
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.
@@ -173,7 +189,7 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
   WriteFileAtomically(out + "/summary.json", json(summary).dump(2));
   WriteJunitXml(out + "/junit.xml", summary);
 
-  WriteTiming(out, results);
+  const std::optional<RunTiming> timing = WriteTiming(out, results);
   std::vector<PlotTrajectory> trajectories;
   for (const auto& r : results) {
     const std::string dir = TrialDir(out, r.index);
@@ -191,7 +207,8 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
     log << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
               << " (actual " << c.actual << ")\n";
   }
-  log << "outputs in " << out << " (summary.json, junit.xml, trajectories.png, localization_errors.png)\n";
+  if (timing) log << "summed over the trials' processes, " << FormatRunTiming(*timing);
+  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, trajectories.png, localization_errors.png)\n";
   return summary.pass ? 0 : 1;
 }
 

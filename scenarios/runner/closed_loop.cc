@@ -17,11 +17,14 @@ bool RunClosedLoop(sim::Simulator& simulator, Controller& controller, const std:
     fixes.clear();
     simulator.Step(&sensors, &truth);
     const double t = simulator.time();
-    if (options.render_on_demand && truth.ring_exposed &&
-        (controller.WantsRingFrame(t) || (options.ring_demand && options.ring_demand(truth)))) {
-      sim::RingCapture capture = simulator.CaptureRing(false);
-      sensors.ring = std::move(capture.frame);
-      truth.ring = std::move(capture.truth);
+    if (options.render_on_demand && truth.ring_exposed) {
+      messages::RingRequest request = controller.RingRequestAt(t);
+      if (options.ring_demand && options.ring_demand(truth)) request = messages::Merge(request, simulator.WholeRing());
+      if (!request.empty()) {
+        sim::RingCapture capture = simulator.CaptureRing(request, false);
+        sensors.ring = std::move(capture.frame);
+        truth.ring = std::move(capture.truth);
+      }
     }
     if (options.pose_fixes != nullptr) options.pose_fixes->Step(truth, &fixes);
 

@@ -36,8 +36,8 @@ class Controller {
   // The step's sensor messages (and pose fixes from an external source) in, commands out.
   virtual messages::RobotCommands Step(double time, const sim::SensorOutputs& sensors,
                                        const std::vector<messages::PoseFix>& pose_fixes) = 0;
-  // Whether a ring frame exposed at `time` would be used (for on-demand rendering).
-  virtual bool WantsRingFrame(double time) const { return false; }
+  // What of a ring frame exposed at `time` it would use (for on-demand rendering; empty: none).
+  virtual messages::RingRequest RingRequestAt(double /*time*/) const { return {}; }
   // The mission is over (done or given up).
   virtual bool Finished() const = 0;
   virtual const stack::Telemetry* telemetry() const { return nullptr; }
@@ -51,11 +51,11 @@ class Observer {
 
 struct LoopOptions {
   double time_limit = 0.0;                 // s of simulated time
-  // The simulator renders the ring only when the controller wants a frame (it must have been
-  // configured with render_cameras and without cameras_on_schedule).
+  // The simulator renders only the cameras the controller asks for, when it asks (it must have
+  // been configured with render_cameras and without cameras_on_schedule).
   bool render_on_demand = false;
-  // Whether an offline consumer beside the controller (e.g. the map builder) wants the ring frame
-  // exposed in this step; with render_on_demand the ring is rendered if either wants it.
+  // Whether an offline consumer beside the controller (e.g. the map builder) wants the whole ring
+  // exposed in this step, at the simulator's configured resolution; merged with the controller's.
   std::function<bool(const sim::GroundTruth&)> ring_demand;
   SimulatedPoseFixes* pose_fixes = nullptr;  // test fixture, when the stack is configured for it
   std::function<void(double)> progress;    // called about once per simulated second

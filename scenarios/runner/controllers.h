@@ -19,7 +19,7 @@ class StackController : public Controller {
   explicit StackController(stack::RobotStack& stack) : stack_(stack) {}
   messages::RobotCommands Step(double time, const sim::SensorOutputs& sensors,
                                const std::vector<messages::PoseFix>& pose_fixes) override;
-  bool WantsRingFrame(double time) const override { return stack_.WantsRingFrame(time); }
+  messages::RingRequest RingRequestAt(double time) const override { return stack_.RingRequestAt(time); }
   bool Finished() const override;
   const stack::Telemetry* telemetry() const override { return &stack_.telemetry(); }
 
@@ -34,7 +34,9 @@ class DrivePlanPlayer : public Controller {
       : plan_(plan), duration_(duration), listener_(listener) {}
   messages::RobotCommands Step(double time, const sim::SensorOutputs& sensors,
                                const std::vector<messages::PoseFix>& pose_fixes) override;
-  bool WantsRingFrame(double time) const override { return listener_ != nullptr && listener_->WantsRingFrame(time); }
+  messages::RingRequest RingRequestAt(double time) const override {
+    return listener_ != nullptr ? listener_->RingRequestAt(time) : messages::RingRequest{};
+  }
   bool Finished() const override { return finished_; }
   const stack::Telemetry* telemetry() const override { return listener_ ? &listener_->telemetry() : nullptr; }
 

@@ -73,7 +73,8 @@ QueryDrive RenderQueryDrive(const QueryDriveOptions& options, const ProjectPaths
   sim::SimulatorConfig config = MakeSimulatorConfig(paths, drive.world, work_dir + "/world");
   config.render_cameras = true;
   config.cameras_on_schedule = false;
-  config.resolution_scale = options.resolution_scale;
+  config.resolution_scale = *options.resolution_scale;
+  config.msaa_samples = options.msaa_samples;
   sim::Simulator simulator(config);
   QueryRecorder recorder(options.interval);
   const double duration = std::min(plan.duration(), options.seconds.value_or(plan.duration()));
@@ -90,8 +91,9 @@ QueryDrive RenderQueryDrive(const QueryDriveOptions& options, const ProjectPaths
   return drive;
 }
 
-// The stack's localizer as robot/config/stack.yaml (with the overrides) configures it.
-std::unique_ptr<VisualLocalizer> MakeLocalizer(const LocalizationEvalOptions& options) {
+// The stack's localizer as robot/config/stack.yaml (with the overrides) configures it, and the
+// query drive's options with the resolution defaulting to what that localizer asks for.
+std::unique_ptr<VisualLocalizer> MakeLocalizer(const LocalizationEvalOptions& options, QueryDriveOptions* drive) {
   const robot::RobotFiles files = options.paths.robot_files();
   stack::StackParameters parameters = stack::StackParameters::Load(files.stack_parameters);
   if (!options.stack_overrides.empty()) {
@@ -99,6 +101,8 @@ std::unique_ptr<VisualLocalizer> MakeLocalizer(const LocalizationEvalOptions& op
     ApplyOverrides(root, ParseOverrides(options.stack_overrides), "--set");
     parameters = parameters.Overridden(YamlMap(root, "--set", ""));
   }
+  *drive = options.drive;
+  if (!drive->resolution_scale) drive->resolution_scale = parameters.visual.image_scale;
   return stack::MakeVisualLocalizer(options.map_path, parameters.visual, robot::LoadCameraRig(files));
 }
 
@@ -116,11 +120,12 @@ class NoisyPrior {
   double sigma_;
 };
 
-nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDrive& drive) {
-  return {{"map", options.map_path}, {"plan", options.drive.plan_path}, {"seed", drive.world.seed},
+nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriveOptions& query, const QueryDrive& drive) {
+  return {{"map", options.map_path}, {"plan", query.plan_path}, {"seed", drive.world.seed},
           {"time_of_day", drive.world.conditions.time_of_day}, {"day_of_year", drive.world.conditions.day_of_year},
-          {"growth", drive.world.conditions.growth}, {"lateral_offset_m", options.drive.lateral_offset},
-          {"resolution_scale", options.drive.resolution_scale}, {"prior_sigma_m", options.prior_sigma},
+          {"growth", drive.world.conditions.growth}, {"lateral_offset_m", query.lateral_offset},
+          {"resolution_scale", *query.resolution_scale}, {"msaa_samples", query.msaa_samples},
+          {"prior_sigma_m", options.prior_sigma},
           {"stack_overrides", options.stack_overrides}, {"frames", drive.frames.size()}};
 }
 
@@ -128,8 +133,9 @@ nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriv
 
 int RunLocalizationBench(const LocalizationEvalOptions& options) {
   std::filesystem::create_directories(options.out_dir);
-  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options);
-  const QueryDrive drive = RenderQueryDrive(options.drive, options.paths, options.out_dir);
+  QueryDriveOptions query;
+  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
+  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
   NoisyPrior prior(drive.world.seed, options.prior_sigma);
   std::vector<visual_localization::LocalizationTimings> timings;
   std::vector<double> position_errors, heading_errors;
@@ -154,7 +160,7 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
   }
   const double n = std::max<double>(1, drive.frames.size());
   const ErrorStats position = ErrorStats::From(position_errors), heading = ErrorStats::From(heading_errors);
-  nlohmann::json report = DriveJson(options, drive);
+  nlohmann::json report = DriveJson(options, query, drive);
   report["fix_rate"] = fixes / n;
   report["fixes_within_25cm_rate"] = within_25cm / n;
   report["position_error_m"] = {{"mean", position.mean}, {"median", position.median}, {"max", position.max}};
@@ -190,8 +196,9 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
 
 int RunRetrievalEval(const LocalizationEvalOptions& options) {
   std::filesystem::create_directories(options.out_dir);
-  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options);
-  const QueryDrive drive = RenderQueryDrive(options.drive, options.paths, options.out_dir);
+  QueryDriveOptions query;
+  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
+  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
   NoisyPrior prior(drive.world.seed, options.prior_sigma);
   constexpr std::array<int, 3> kThresholds = {50, 100, 200};
   const std::array<std::pair<Retrieval, const char*>, 3> methods = {
@@ -228,7 +235,7 @@ int RunRetrievalEval(const LocalizationEvalOptions& options) {
       }
     }
   }
-  nlohmann::json report = DriveJson(options, drive);
+  nlohmann::json report = DriveJson(options, query, drive);
   std::printf("%-12s %28s   %28s\n", "retrieval", "single image [%]", "generalized image (rig) [%]");
   std::printf("%-12s %8s %9s %9s   %8s %9s %9s\n", "", ">= 50", ">= 100", ">= 200", ">= 50", ">= 100", ">= 200");
   for (std::size_t m = 0; m < methods.size(); ++m) {

@@ -26,7 +26,8 @@ struct QueryDriveOptions {
   double lateral_offset = 0.0;            // m: the start moved to the left of its heading
   std::optional<double> seconds;          // stop the drive early
   double interval = 1.0;                  // s of simulated time between query frames
-  double resolution_scale = 0.5;          // as the trials render
+  std::optional<double> resolution_scale;  // default: what the stack asks for (its image_scale)
+  int msaa_samples = 4;                   // the renderer's anti-aliasing (as the trials render)
 };
 
 struct LocalizationEvalOptions {

@@ -60,8 +60,9 @@ struct Scenario {
   int trials = 1;
   double time_limit = 300.0;           // s of simulated time per trial
   double wall_time_limit = 1800.0;     // s of wall-clock time per trial before it is killed
-  bool render_cameras = false;         // rendering costs ~0.5-1 s per ring frame
-  double resolution_scale = 0.5;       // when rendering
+  bool render_cameras = false;         // the whole ring on the camera schedule (~0.5-0.9 s a frame);
+                                       // the stack's own requests are rendered regardless
+  double resolution_scale = 0.5;       // of the scheduled ring (a request carries its own)
   double imu_noise_scale = 1.0;
   double wheel_slip_scale = 1.0;
   SimulatedPoseFixParameters simulated_pose_fixes;  // test fixture, used when the stack asks for it

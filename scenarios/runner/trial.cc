@@ -11,6 +11,7 @@
 #include "runner/controllers.h"
 #include "runner/prior_knowledge.h"
 #include "reports/localization_timing.h"
+#include "reports/run_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
@@ -18,7 +19,7 @@
 namespace trimbot::scenarios {
 namespace {
 
-// `render_for_stack`: the stack's localization asks for the ring frames it uses.
+// `render_for_stack`: the stack asks for the ring cameras it uses, when it uses them.
 sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   const Scenario& scenario = *setup.scenario;
   WorldSetup world = scenario.world;
@@ -33,11 +34,9 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   return config;
 }
 
-void WriteTiming(const std::string& dir, double wall_seconds, double simulated_seconds, const stack::StackTimings& t) {
-  nlohmann::json timing = {
-      {"wall_seconds", wall_seconds},
-      {"real_time_factor", wall_seconds > 0 ? simulated_seconds / wall_seconds : 0.0},
-      {"stack_seconds", {{"localization", t.localization}, {"navigation", t.navigation}, {"perception", t.perception}}}};
+void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t) {
+  nlohmann::json timing = ToJson(run);
+  WriteRunTimingChart(dir + "/timing.png", "where the trial's time went", run);
   if (!t.visual_frames.empty()) {
     timing["visual_localization"] = LocalizationTimeStats(t.visual_frames);
     WriteLocalizationTimeHistogram(dir + "/localization_time.png", "visual localization time per frame, this trial",
@@ -62,7 +61,8 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
   const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
-  sim::Simulator simulator(PlantFor(setup, visual));
+  const bool stack_uses_images = visual || parameters.local_fusion.enabled;
+  sim::Simulator simulator(PlantFor(setup, stack_uses_images));
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
   robot.SetMap(setup.map_yaml);
@@ -79,16 +79,23 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   LoopOptions options;
   options.time_limit = scenario.time_limit;
   options.pose_fixes = fixes ? &*fixes : nullptr;
-  options.render_on_demand = visual;
+  options.render_on_demand = stack_uses_images;
   options.progress = progress;
+  const auto loop_start = std::chrono::steady_clock::now();
   const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
   result.simulated_seconds = simulator.time();
-  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const auto report_start = std::chrono::steady_clock::now();
   evaluator.WriteFiles(setup.dir);
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
-  WriteTiming(setup.dir, result.wall_seconds, result.simulated_seconds, robot.telemetry().timings);
+  const auto seconds = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
+  const auto now = std::chrono::steady_clock::now();
+  const RunTiming run = MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(),
+                                      &robot.telemetry().timings, seconds(wall_start, loop_start),
+                                      seconds(report_start, now));
+  WriteTiming(setup.dir, run, robot.telemetry().timings);
   return result;
 }
 

@@ -3,6 +3,8 @@
 #include <GL/osmesa.h>
 
 #include <opencv2/imgproc.hpp>
+#include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace trimbot::sim {
@@ -17,33 +19,17 @@ struct RingRenderer::GlState {
   std::vector<float> depth;
 };
 
-RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, double resolution_scale,
-                           double oversampling)
-    : world_(world), gl_(std::make_unique<GlState>()) {
-  const mjModel* m = world.model();
-  for (const auto& calibration : rig.cameras()) {
-    CameraSetup setup;
-    setup.model = Scaled(calibration.intrinsics, resolution_scale);
-    // The MJCF camera's fovy was set for the full-resolution render; keep the angle, scale pixels.
-    const RenderPinhole full = RenderPinholeFor(calibration.intrinsics, oversampling);
-    setup.render = full;
-    setup.render.width = static_cast<int>(std::lround(full.width * resolution_scale / 2.0)) * 2;
-    setup.render.height = static_cast<int>(std::lround(full.height * resolution_scale / 2.0)) * 2;
-    setup.render.focal = 0.5 * setup.render.height / std::tan(0.5 * full.fovy_degrees * M_PI / 180.0);
-    setup.render.cx = (setup.render.width - 1) / 2.0;
-    setup.render.cy = (setup.render.height - 1) / 2.0;
-    setup.map_x.create(setup.model.height, setup.model.width, CV_32F);
-    setup.map_y.create(setup.model.height, setup.model.width, CV_32F);
-    for (int v = 0; v < setup.model.height; ++v) {
-      for (int u = 0; u < setup.model.width; ++u) {
-        const Eigen::Vector2d ray = setup.model.Undistort(Eigen::Vector2d(u, v));
-        setup.map_x.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.x() + setup.render.cx);
-        setup.map_y.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.y() + setup.render.cy);
-      }
-    }
-    cameras_.push_back(std::move(setup));
-  }
+namespace {
 
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+}  // namespace
+
+RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, double oversampling)
+    : world_(world), rig_(rig), oversampling_(oversampling), gl_(std::make_unique<GlState>()) {
+  const mjModel* m = world.model();
   const int width = m->vis.global.offwidth, height = m->vis.global.offheight;
   gl_->context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
   if (gl_->context == nullptr) throw std::runtime_error("OSMesa: cannot create an OpenGL context");
@@ -62,11 +48,6 @@ RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, doub
   gl_->option.geomgroup[3] = 0;  // collision geometry is not drawn
   gl_->rgb.resize(static_cast<size_t>(width) * height * 3);
   gl_->depth.resize(static_cast<size_t>(width) * height);
-  for (const auto& camera : cameras_) {
-    if (camera.render.width > width || camera.render.height > height) {
-      throw std::runtime_error("render size exceeds the world's offscreen buffer");
-    }
-  }
 }
 
 RingRenderer::~RingRenderer() {
@@ -75,9 +56,49 @@ RingRenderer::~RingRenderer() {
   OSMesaDestroyContext(gl_->context);
 }
 
+const RingRenderer::CameraSetup& RingRenderer::Setup(int index, double resolution_scale) {
+  if (index < 0 || index >= rig_.size()) throw std::out_of_range("RingRenderer: no camera " + std::to_string(index));
+  if (!(resolution_scale > 0.0 && resolution_scale <= 1.0)) {
+    throw std::invalid_argument("RingRenderer: resolution scale must be in (0, 1]");
+  }
+  const std::pair<int, long> key(index, std::lround(resolution_scale * 10000.0));
+  auto found = setups_.find(key);
+  if (found != setups_.end()) return found->second;
+  const robot::PinholeRadtan& calibration = rig_.camera(index).intrinsics;
+  CameraSetup setup;
+  setup.model = Scaled(calibration, resolution_scale);
+  // The MJCF camera's fovy was set for the full-resolution render; keep the angle, scale pixels.
+  const RenderPinhole full = RenderPinholeFor(calibration, oversampling_);
+  setup.render = full;
+  setup.render.width = static_cast<int>(std::lround(full.width * resolution_scale / 2.0)) * 2;
+  setup.render.height = static_cast<int>(std::lround(full.height * resolution_scale / 2.0)) * 2;
+  setup.render.focal = 0.5 * setup.render.height / std::tan(0.5 * full.fovy_degrees * M_PI / 180.0);
+  setup.render.cx = (setup.render.width - 1) / 2.0;
+  setup.render.cy = (setup.render.height - 1) / 2.0;
+  const mjModel* m = world_.model();
+  if (setup.render.width > m->vis.global.offwidth || setup.render.height > m->vis.global.offheight) {
+    throw std::runtime_error("render size exceeds the world's offscreen buffer");
+  }
+  setup.map_x.create(setup.model.height, setup.model.width, CV_32F);
+  setup.map_y.create(setup.model.height, setup.model.width, CV_32F);
+  for (int v = 0; v < setup.model.height; ++v) {
+    for (int u = 0; u < setup.model.width; ++u) {
+      const Eigen::Vector2d ray = setup.model.Undistort(Eigen::Vector2d(u, v));
+      setup.map_x.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.x() + setup.render.cx);
+      setup.map_y.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.y() + setup.render.cy);
+    }
+  }
+  return setups_.emplace(key, std::move(setup)).first->second;
+}
+
+const robot::PinholeRadtan& RingRenderer::camera_model(int index, double resolution_scale) {
+  return Setup(index, resolution_scale).model;
+}
+
 void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool segmentation, cv::Mat* rgb,
                               cv::Mat* depth) {
   const mjModel* m = world_.model();
+  auto start = Clock::now();
   mjvCamera view;
   mjv_defaultCamera(&view);
   view.type = mjCAMERA_FIXED;
@@ -87,10 +108,14 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   gl_->scene.flags[mjRND_IDCOLOR] = segmentation ? 1 : 0;
   const mjrRect viewport = {0, 0, camera.render.width, camera.render.height};
   mjr_render(viewport, &gl_->scene, &gl_->render_context);
+  glFinish();  // llvmpipe draws asynchronously: wait here so the draw is timed as drawing
+  if (!segmentation) timings_.draw += SecondsSince(start);
+  start = Clock::now();
   mjr_readPixels(gl_->rgb.data(), depth ? gl_->depth.data() : nullptr, viewport, &gl_->render_context);
   // OpenGL rows start at the bottom.
   const cv::Mat rgb_up(camera.render.height, camera.render.width, CV_8UC3, gl_->rgb.data());
   cv::flip(rgb_up, *rgb, 0);
+  if (!segmentation) timings_.readback += SecondsSince(start);
   if (depth != nullptr) {
     const cv::Mat depth_up(camera.render.height, camera.render.width, CV_32F, gl_->depth.data());
     cv::Mat buffer;
@@ -109,8 +134,8 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   }
 }
 
-RenderedView RingRenderer::Render(int index, bool with_ground_truth) {
-  const CameraSetup& camera = cameras_.at(static_cast<size_t>(index));
+RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_ground_truth) {
+  const CameraSetup& camera = Setup(index, resolution_scale);
   // Several renderers (simulators) may live in one process; each draws with its own context.
   const mjModel* m = world_.model();
   if (OSMesaGetCurrentContext() != gl_->context &&
@@ -122,8 +147,13 @@ RenderedView RingRenderer::Render(int index, bool with_ground_truth) {
   RenderedView view;
   cv::Mat rgb, depth;
   RenderPass(camera, camera_id, false, &rgb, with_ground_truth ? &depth : nullptr);
+  auto start = Clock::now();
   cv::remap(rgb, view.rgb, camera.map_x, camera.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  timings_.distortion += SecondsSince(start);
+  ++timings_.images;
   if (!with_ground_truth) return view;
+
+  start = Clock::now();
 
   cv::remap(depth, view.depth, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::Mat segmentation;
@@ -149,6 +179,7 @@ RenderedView RingRenderer::Render(int index, bool with_ground_truth) {
   cv::remap(object_id, view.object_id, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   // The skybox is drawn as far geometry; where nothing was hit, depth is "none" (0).
   view.depth.setTo(0.0f, view.object_class == 0);
+  timings_.ground_truth += SecondsSince(start);
   return view;
 }
 

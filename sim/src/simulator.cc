@@ -11,6 +11,7 @@
 #include "trimbot/sim/base_controller.h"
 #include "trimbot/sim/camera_exposure.h"
 #include "trimbot/sim/imu_model.h"
+#include "trimbot/sim/camera_noise.h"
 #include "trimbot/sim/ring_renderer.h"
 #include "trimbot/sim/wheel_encoder_model.h"
 #include "trimbot/sim/world.h"
@@ -44,6 +45,7 @@ Eigen::Isometry3d PoseFromMujoco(const mjtNum* pos, const mjtNum* mat) {
 struct Simulator::Impl {
   std::unique_ptr<World> world;
   std::unique_ptr<RingRenderer> renderer;
+  std::unique_ptr<ReadNoise> read_noise;
   std::unique_ptr<BaseController> base;
   std::unique_ptr<ArmController> arm;
   std::unique_ptr<ImuModel> imu;
@@ -56,7 +58,7 @@ struct Simulator::Impl {
   garden::SlipModel ground_slip[4];
   std::vector<bool> fault_applied;
   int end_effector_body = -1;
-  double render_seconds = 0.0;  // looked up once: ground truth is read every step in closed loop
+  SimulatorTimings timings;     // physics and exposure/noise here; the renderer keeps its own
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
@@ -113,7 +115,8 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->end_effector_body = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
   impl_->fault_applied.assign(config.faults.size(), false);
   if (config.render_cameras) {
-    impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.resolution_scale);
+    impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_);
+    impl_->read_noise = std::make_unique<ReadNoise>(StreamSeed(config.seed, "camera_read_noise"));
   }
 }
 
@@ -151,6 +154,7 @@ const garden::SlipModel* Simulator::SurfaceUnder(int wheel_geom) const {
 }
 
 void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
+  const auto physics_start = std::chrono::steady_clock::now();
   World& world = *impl_->world;
   mjModel* m = world.model();
   mjData* d = world.data();
@@ -177,14 +181,16 @@ void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
   ReadSensors(stamp_before, sensors);
 
   const bool ring_exposed = cameras_available && impl_->step % impl_->camera_steps == 0;
+  *truth = ground_truth();
+  truth->contacts = ObstacleContacts();
+  truth->ring_exposed = ring_exposed;
+  impl_->timings.physics += std::chrono::duration<double>(std::chrono::steady_clock::now() - physics_start).count();
+  ++impl_->timings.physics_steps;
   std::optional<RingCapture> capture;
   if (ring_exposed && impl_->renderer && config_.cameras_on_schedule) {
     const int every = config_.ground_truth_every_frames;
     capture = CaptureRing(every > 0 && impl_->frame % every == 0);
   }
-  *truth = ground_truth();
-  truth->contacts = ObstacleContacts();
-  truth->ring_exposed = ring_exposed;
   if (capture) {
     sensors->ring = std::move(capture->frame);
     truth->ring = std::move(capture->truth);
@@ -251,30 +257,44 @@ bool Simulator::ApplyFaults() {
   return cameras_available;
 }
 
-double Simulator::render_seconds() const { return impl_->render_seconds; }
-long Simulator::rendered_frames() const { return impl_->frame; }
+SimulatorTimings Simulator::timings() const {
+  SimulatorTimings out = impl_->timings;
+  if (impl_->renderer) {
+    const RenderTimings& r = impl_->renderer->timings();
+    out.render_draw = r.draw;
+    out.render_readback = r.readback;
+    out.distortion = r.distortion;
+    out.ground_truth = r.ground_truth;
+    out.camera_images = r.images;
+  }
+  return out;
+}
 
-RingCapture Simulator::CaptureRing(bool with_ground_truth) {
+messages::RingRequest Simulator::WholeRing() const {
+  messages::RingRequest all;
+  for (int i = 0; i < rig_.size(); ++i) all.cameras.push_back(i);
+  all.resolution_scale = config_.resolution_scale;
+  return all;
+}
+
+RingCapture Simulator::CaptureRing(bool with_ground_truth) { return CaptureRing(WholeRing(), with_ground_truth); }
+
+RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool with_ground_truth) {
   if (!impl_->renderer) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
-  const auto start = std::chrono::steady_clock::now();
   World& world = *impl_->world;
   mj_forward(world.model(), world.data());  // kinematics at the current time
   RingCapture capture;
   capture.frame.stamp = world.data()->time;
   RingTruth& truth = capture.truth;
-  for (int i = 0; i < rig_.size(); ++i) {
-    RenderedView view = impl_->renderer->Render(i, with_ground_truth);
+  if (with_ground_truth) truth.views.resize(static_cast<std::size_t>(rig_.size()));
+  for (int i : request.cameras) {
+    RenderedView view = impl_->renderer->Render(i, request.resolution_scale, with_ground_truth);
+    const auto start = std::chrono::steady_clock::now();
     // The sensor's exposure control, then its read noise (amplified by the gain), seeded per frame
     // and camera so each image is reproducible on its own.
     const ExposureResult exposure = ApplyAutoExposure(view.rgb, parameters_.cameras.auto_exposure);
-    if (parameters_.cameras.noise_sigma > 0.0) {
-      cv::RNG rng(StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i)));
-      cv::Mat noise(view.rgb.size(), CV_16SC3);
-      rng.fill(noise, cv::RNG::NORMAL, 0.0, parameters_.cameras.noise_sigma * exposure.gain);
-      cv::Mat noisy;
-      cv::add(view.rgb, noise, noisy, cv::noArray(), CV_8UC3);
-      view.rgb = noisy;
-    }
+    impl_->read_noise->Apply(view.rgb, parameters_.cameras.noise_sigma * exposure.gain,
+                             StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i)));
     messages::Image image;
     image.stamp = capture.frame.stamp;
     image.camera_index = i;
@@ -283,15 +303,17 @@ RingCapture Simulator::CaptureRing(bool with_ground_truth) {
     image.encoding = "rgb8";
     image.data.assign(view.rgb.data, view.rgb.data + view.rgb.total() * view.rgb.elemSize());
     capture.frame.images.push_back(std::move(image));
-
+    impl_->timings.exposure_noise += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (with_ground_truth) truth.views[static_cast<std::size_t>(i)] = std::move(view);
+  }
+  for (int i = 0; i < rig_.size(); ++i) {
     const int id = world.camera_id(i);
     Eigen::Isometry3d T_map_camera = PoseFromMujoco(world.data()->cam_xpos + 3 * id, world.data()->cam_xmat + 9 * id);
     T_map_camera.linear() = T_map_camera.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
     truth.T_map_camera.push_back(T_map_camera);
-    if (with_ground_truth) truth.views.push_back(std::move(view));
   }
   ++impl_->frame;
-  impl_->render_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++impl_->timings.ring_frames;
   return capture;
 }
 

@@ -1,6 +1,7 @@
 #include "trimbot/stack/navigator.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -51,7 +52,9 @@ void Navigator::GiveUpGoal(double stamp, const std::string& why) {
 }
 
 void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
+  const auto start = std::chrono::steady_clock::now();
   const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goals_[goal_], plan_failures_);
+  planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
     Emit(stamp, NavigationEvent::Type::kPlanFailed, plan.message);
     if (++plan_failures_ >= parameters_.max_plan_failures) GiveUpGoal(stamp, "no path: " + plan.message);

@@ -1,5 +1,6 @@
 #include "trimbot/stack/robot_stack.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -93,6 +94,7 @@ std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const 
   options.pose.min_inliers = v.min_inliers;
   if (v.left_cameras_only) {
     for (const auto& pair : rig.StereoPairs()) options.cameras.push_back(pair.left);
+    std::sort(options.cameras.begin(), options.cameras.end());
   }
   return std::make_unique<visual_localization::VisualLocalizer>(
       visual_localization::VisualMap::Load(map_path, "", visual_localization::RigSignature(rig), v.descriptor), rig,
@@ -138,12 +140,12 @@ void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
 void RobotStack::SetTeleopCommand(const messages::BaseVelocityCommand& command) { teleop_ = command; }
 
 void RobotStack::Add(const messages::ImuSample& imu) {
-  ScopedTimer timer(&telemetry_.timings.localization);
+  ScopedTimer timer(&telemetry_.timings.ekf);
   components_->ekf.AddImu(imu);
 }
 
 void RobotStack::Add(const messages::WheelTicks& ticks) {
-  ScopedTimer timer(&telemetry_.timings.localization);
+  ScopedTimer timer(&telemetry_.timings.ekf);
   components_->ekf.AddWheelTicks(ticks);
   components_->odometry.Update(ticks);
 }
@@ -167,7 +169,7 @@ void RobotStack::Add(const messages::PoseFix& fix) {
     ++telemetry_.pose_fixes_ignored;
     return;
   }
-  ScopedTimer timer(&telemetry_.timings.localization);
+  ScopedTimer timer(&telemetry_.timings.ekf);
   components_->ekf.AddPoseFix(fix);
 }
 
@@ -176,12 +178,23 @@ bool RobotStack::VisualLocalizationDue(double stamp) const {
          stamp + 1e-9 >= next_localization_ && stamp >= localizer_busy_until_;
 }
 
-bool RobotStack::WantsRingFrame(double stamp) const {
-  return VisualLocalizationDue(stamp) || (components_->fusion != nullptr && components_->fusion->Wants(stamp));
+messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
+  messages::RingRequest request;
+  if (VisualLocalizationDue(stamp)) {
+    request.cameras = components_->localizer->cameras();
+    request.resolution_scale = parameters_.visual.image_scale;
+  }
+  if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
+    messages::RingRequest stereo;
+    for (int i = 0; i < components_->rig.size(); ++i) stereo.cameras.push_back(i);
+    stereo.resolution_scale = parameters_.local_fusion.image_scale;
+    request = messages::Merge(request, stereo);
+  }
+  return request;
 }
 
 void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
-  ScopedTimer timer(&telemetry_.timings.localization);
+  ScopedTimer timer(&telemetry_.timings.visual_localization);
   Components& c = *components_;
   std::optional<Eigen::Vector2d> prior;
   if (c.ekf.initialized()) {
@@ -221,7 +234,10 @@ void RobotStack::DeliverVisualFixes(double stamp) {
       ++it;
       continue;
     }
-    components_->ekf.AddPoseFix(it->fix);
+    {
+      ScopedTimer timer(&telemetry_.timings.ekf);
+      components_->ekf.AddPoseFix(it->fix);
+    }
     telemetry_.visual_fixes.push_back(it->fix);
     it = pending_fixes_.erase(it);
   }
@@ -260,7 +276,8 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   }
   Navigator* navigator = components_->navigator.get();
   if (navigator == nullptr) return;
-  ScopedTimer timer(&telemetry_.timings.navigation);
+  const double planning_before = navigator->planning_seconds();
+  const auto start = std::chrono::steady_clock::now();
   if (LocalizationLost()) {
     // Better to stand than to drive blind: wait for the localization to come back.
     commands->base = messages::BaseVelocityCommand{};
@@ -271,6 +288,9 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   telemetry_.events = navigator->TakeEvents();
   telemetry_.mission = ToMission(navigator->mode());
   telemetry_.current_goal = navigator->current_goal();
+  const double planning = navigator->planning_seconds() - planning_before;
+  telemetry_.timings.planning += planning;
+  telemetry_.timings.control += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - planning;
 }
 
 }  // namespace trimbot::stack

@@ -83,6 +83,7 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
     if (cameras != "all" && cameras != "left") r.map().Fail("cameras", "must be all or left");
     p.left_cameras_only = cameras == "left";
   }
+  r.Number("image_scale", &p.image_scale, 0.05, 1.0);
   r.Integer("keyframes", &p.keyframes, 1, 1000);
   r.Number("prior_radius", &p.prior_radius, 0.1, 1000.0, "m");
   r.Integer("min_inliers", &p.min_inliers, 4, 100000);
@@ -172,6 +173,7 @@ void Read(Reader& r, StackParameters& s) {
       f.Number("interval", &p.interval, 0.05, 3600.0, "s");
       f.Integer("stride", &p.stride, 1, 64);
       f.Number("ground_keep", &p.ground_keep, 0.0, 1.0);
+      f.Number("image_scale", &p.image_scale, 0.05, 1.0);
     });
   });
 }

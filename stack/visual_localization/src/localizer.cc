@@ -197,6 +197,13 @@ std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features
   return correspondences;
 }
 
+std::vector<int> VisualLocalizer::cameras() const {
+  if (!options_.cameras.empty()) return options_.cameras;
+  std::vector<int> all(T_base_camera_.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  return all;
+}
+
 LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
                                              const std::optional<Eigen::Vector2d>& prior_position) {
   LocalizationResult result;

@@ -1,7 +1,10 @@
 #pragma once
 // Commands: what the stack sends to the robot's actuators.
+#include <algorithm>
 #include <array>
+#include <iterator>
 #include <optional>
+#include <vector>
 
 namespace trimbot::messages {
 
@@ -26,6 +29,25 @@ struct ArmCommand {
 struct CutterCommand {
   bool on = false;
 };
+
+// What the stack asks of the camera ring for the frame triggered at a stamp: which cameras, at
+// what resolution. The driver delivers (the simulator renders) only these; an empty request
+// skips the frame. The real ring's driver would select and bin the same way.
+struct RingRequest {
+  std::vector<int> cameras;       // rig camera indices, ascending, no duplicates
+  double resolution_scale = 1.0;  // fraction of the calibrated image size (0.5: 376x240)
+  bool empty() const { return cameras.empty(); }
+};
+
+// One frame serving both requests: the union of their cameras at the finer resolution.
+inline RingRequest Merge(const RingRequest& a, const RingRequest& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  RingRequest out;
+  std::set_union(a.cameras.begin(), a.cameras.end(), b.cameras.begin(), b.cameras.end(), std::back_inserter(out.cameras));
+  out.resolution_scale = std::max(a.resolution_scale, b.resolution_scale);
+  return out;
+}
 
 // What the robot software sends to the actuators in one update: only the commands that changed
 // (an empty field leaves the actuator on its last command).

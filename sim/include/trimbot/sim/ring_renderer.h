@@ -1,11 +1,14 @@
 #pragma once
 // Offscreen rendering of the ring cameras with OSMesa (software OpenGL: no display, no GPU).
 // Each camera is rendered as a wide ideal pinhole and resampled into its calibrated model
-// (intrinsics and radtan distortion). Besides the colour image it can produce the ground truth:
-// metric depth along the optical axis and per-pixel class and object labels.
+// (intrinsics and radtan distortion) by a remap precomputed per camera and resolution. Besides
+// the colour image it can produce the ground truth: metric depth along the optical axis and
+// per-pixel class and object labels.
 #include <opencv2/core.hpp>
 
+#include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "trimbot/robot/camera_rig.h"
@@ -15,19 +18,28 @@
 
 namespace trimbot::sim {
 
+// Wall-clock seconds spent per rendering stage since the renderer was made.
+struct RenderTimings {
+  double draw = 0.0;        // OpenGL drawing (scene update, shadows, rasterization, MSAA resolve)
+  double readback = 0.0;    // reading the pixels back and flipping them upright
+  double distortion = 0.0;  // resampling the pinhole render into the calibrated (distorted) camera
+  double ground_truth = 0.0;  // depth conversion and the label pass, when asked for
+  long images = 0;          // camera images rendered
+};
+
 class RingRenderer {
  public:
-  // `resolution_scale` renders images at a fraction of the calibrated resolution (0.5 = half).
-  RingRenderer(const World& world, const robot::CameraRig& rig, double resolution_scale = 1.0,
-               double oversampling = 1.0);
+  RingRenderer(const World& world, const robot::CameraRig& rig, double oversampling = 1.0);
   ~RingRenderer();
   RingRenderer(const RingRenderer&) = delete;
   RingRenderer& operator=(const RingRenderer&) = delete;
 
-  // Renders rig camera `index` in the world's current state (call mj_forward first).
-  RenderedView Render(int index, bool with_ground_truth);
-  // The camera model the images follow (the calibration, scaled by resolution_scale).
-  const robot::PinholeRadtan& camera_model(int index) const { return cameras_.at(static_cast<size_t>(index)).model; }
+  // Renders rig camera `index` at `resolution_scale` of its calibrated size (0.5 = half) in the
+  // world's current state (call mj_forward first).
+  RenderedView Render(int index, double resolution_scale, bool with_ground_truth);
+  // The camera model the images at that scale follow (the calibration, scaled).
+  const robot::PinholeRadtan& camera_model(int index, double resolution_scale);
+  const RenderTimings& timings() const { return timings_; }
 
  private:
   struct CameraSetup {
@@ -35,10 +47,15 @@ class RingRenderer {
     RenderPinhole render;
     cv::Mat map_x, map_y;  // output pixel -> render pixel
   };
+  // Built on the first request for a camera and resolution, then kept.
+  const CameraSetup& Setup(int index, double resolution_scale);
   void RenderPass(const CameraSetup& camera, int camera_id, bool segmentation, cv::Mat* rgb, cv::Mat* depth);
 
   const World& world_;
-  std::vector<CameraSetup> cameras_;
+  const robot::CameraRig& rig_;
+  double oversampling_;
+  std::map<std::pair<int, long>, CameraSetup> setups_;  // (camera, scale in 1/10000)
+  RenderTimings timings_;
   struct GlState;
   std::unique_ptr<GlState> gl_;
 };

@@ -94,6 +94,20 @@ struct GroundTruth {
   std::vector<ObstacleContact> contacts;        // robot against garden objects, now
 };
 
+// Wall-clock seconds the simulator spent per stage since it was made (not part of any result:
+// for the run's timing report).
+struct SimulatorTimings {
+  double physics = 0.0;         // actuation, MuJoCo step, IMU / encoder models, contacts
+  double render_draw = 0.0;     // OpenGL drawing of the camera images
+  double render_readback = 0.0; // pixels back from OpenGL
+  double distortion = 0.0;      // pinhole render -> calibrated radtan camera (precomputed remap)
+  double exposure_noise = 0.0;  // auto exposure and read noise
+  double ground_truth = 0.0;    // depth and label images, when asked for
+  long physics_steps = 0;
+  long ring_frames = 0;
+  long camera_images = 0;
+};
+
 struct RingCapture {
   messages::RingFrame frame;   // sensor output (noisy images)
   RingTruth truth;
@@ -124,11 +138,15 @@ class Simulator {
   const robot::RobotParameters& parameters() const { return parameters_; }
   const garden::Garden& garden() const { return garden_; }
   const WorldSpec& world_spec() const { return spec_; }
-  // Renders the cameras now (outside the camera schedule), e.g. for tests and benchmarks.
+  // Renders the cameras now (outside the camera schedule): all of them at the configured
+  // resolution, or those `request` names at its resolution (the frame then holds only those
+  // images; RingTruth's views of the others are empty).
   RingCapture CaptureRing(bool with_ground_truth);
-  // Wall-clock seconds spent rendering ring frames, and how many, since the start.
-  double render_seconds() const;
-  long rendered_frames() const;
+  RingCapture CaptureRing(const messages::RingRequest& request, bool with_ground_truth);
+  // Every camera at the configured resolution (what the camera schedule renders).
+  messages::RingRequest WholeRing() const;
+  // Where the wall-clock time went since the start.
+  SimulatorTimings timings() const;
   // The MuJoCo world, for tests that compare it with the URDF (include trimbot/sim/world.h).
   World& world();
 

@@ -54,6 +54,8 @@ class Navigator {
   const std::vector<Eigen::Vector2d>& path() const { return follower_.path(); }
   // Events since the last call.
   std::vector<NavigationEvent> TakeEvents();
+  // Wall-clock seconds spent in the global planner since construction.
+  double planning_seconds() const { return planning_seconds_; }
 
  private:
   void PlanToCurrentGoal(double stamp, const Pose2& estimate);
@@ -71,6 +73,7 @@ class Navigator {
   int plan_failures_ = 0;
   Eigen::Vector2d backoff_start_ = Eigen::Vector2d::Zero();
   std::vector<NavigationEvent> events_;
+  double planning_seconds_ = 0.0;
 };
 
 }  // namespace trimbot::stack

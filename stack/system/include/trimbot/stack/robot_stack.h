@@ -29,10 +29,13 @@ const char* ToString(MissionState state);
 
 // Wall-clock seconds spent in each part of the stack since it started (not deterministic: for
 // timing reports only).
+// Wall-clock seconds per component since the start (for the run's timing report).
 struct StackTimings {
-  double localization = 0.0;
-  double navigation = 0.0;
-  double perception = 0.0;
+  double ekf = 0.0;                  // IMU, wheel ticks and fixes into the EKF, wheel odometry
+  double visual_localization = 0.0;  // whole frames (split by stage in visual_frames)
+  double perception = 0.0;           // stereo clouds and their registration (local fusion)
+  double planning = 0.0;             // global plans (RRT*)
+  double control = 0.0;              // navigator and path follower, planning excluded
   // Visual localization: each localized frame's time by stage (features, retrieval, matching, pose).
   std::vector<visual_localization::LocalizationTimings> visual_frames;
 };
@@ -101,8 +104,9 @@ class RobotStack {
   void Add(const messages::RingFrame& frame);
   void Add(const messages::PoseFix& fix);  // used when localization is simulated_pose_fixes
 
-  // Whether a component would use a ring frame exposed at `stamp` (so a driver can skip the rest).
-  bool WantsRingFrame(double stamp) const;
+  // What the components would use of a ring frame exposed at `stamp`: the cameras and resolution
+  // (empty: nothing; a driver skips the frame or the cameras not named).
+  messages::RingRequest RingRequestAt(double stamp) const;
 
   // Runs the components due at `stamp` (the latest sensor time) and returns the commands.
   messages::RobotCommands Update(double stamp);

@@ -78,6 +78,8 @@ class VisualLocalizer {
 
   const VisualMap& map() const { return map_; }
   const LocalizerOptions& options() const { return options_; }
+  // The ring cameras it uses (the options' list, or every camera of the rig).
+  std::vector<int> cameras() const;
   const std::vector<Eigen::Isometry3d>& T_base_camera() const { return T_base_camera_; }
 
  private:

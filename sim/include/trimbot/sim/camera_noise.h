@@ -1,0 +1,25 @@
+#pragma once
+// The cameras' read noise: additive Gaussian per pixel and channel. Drawing a million Gaussian
+// samples per full-resolution image cost more than distorting it (4 ms a camera); instead the
+// simulator draws a bank of unit samples once, from its seed, and each image takes a window of it
+// chosen by the image's own stream seed, scaled by sigma. Windows start anywhere in a bank four
+// times the largest image, so neighbouring images' noise is not aligned.
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace trimbot::sim {
+
+class ReadNoise {
+ public:
+  explicit ReadNoise(std::uint64_t seed, std::size_t bank_size = std::size_t{1} << 22);
+  // Adds Gaussian noise of `sigma` grey levels to `rgb` (CV_8UC3, saturating at 0 and 255), from
+  // the window `image_seed` picks: the same image seed, the same noise.
+  void Apply(cv::Mat& rgb, double sigma, std::uint64_t image_seed) const;
+
+ private:
+  std::vector<float> bank_;  // unit normal samples
+};
+
+}  // namespace trimbot::sim
