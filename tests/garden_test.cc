@@ -13,6 +13,7 @@
 
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 namespace trimbot::garden {
@@ -85,6 +86,77 @@ TEST(Textures, SameSeedSameImageOtherSeedOther) {
   cv::Scalar mean, stddev;
   cv::meanStdDev(a, mean, stddev);
   EXPECT_GT(stddev[1], 10.0);
+}
+
+// Ground variants: the base tile's texels along the border (any arrangement of variants is
+// seamless), different inside (the lawn does not repeat every tile).
+TEST(Textures, GroundVariantsShareTheBaseBorderAndDifferInside) {
+  const cv::Mat base = MakeTexture(Material::kGrass, 5, 128);
+  const cv::Rect border_band(0, 0, 128, 8), inside(40, 40, 48, 48);
+  for (int k = 0; k < kGroundVariants; ++k) {
+    const cv::Mat variant = MakeGroundVariant(Material::kGrass, 5, 128, k);
+    ASSERT_EQ(variant.size(), base.size());
+    EXPECT_EQ(cv::norm(variant(border_band), base(border_band), cv::NORM_INF), 0.0) << "variant " << k;
+    cv::Mat difference;
+    cv::absdiff(variant(inside), base(inside), difference);
+    EXPECT_GT(cv::mean(difference)[1], 5.0) << "variant " << k << " differs from the base inside";
+  }
+  EXPECT_THROW(MakeGroundVariant(Material::kBark, 5, 64, 0), std::invalid_argument);
+  EXPECT_THROW(MakeGroundVariant(Material::kGrass, 5, 64, kGroundVariants), std::invalid_argument);
+}
+
+// The lawn's patches cover the area, each showing one whole variant (texture coordinates 0..1, so
+// neighbours meet on the shared border texels), all variants used, columns mirrored and not.
+TEST(LawnMesh, PatchesShowWholeVariantsMixedAndCoverTheArea) {
+  const Eigen::Vector2d min(-20.0, -18.0);
+  const std::vector<Mesh> meshes = LawnMeshes(min, {20.0, 18.0}, 4.0, 3);  // 10 x 9 patches
+  ASSERT_EQ(meshes.size(), static_cast<std::size_t>(kGroundVariants));
+  struct Patch {
+    double u_min = 1e9, u_max = -1e9, v_min = 1e9, v_max = -1e9, u_at_x_min = 0.0, x_min = 1e9;
+    int faces = 0;
+  };
+  double top_area = 0.0;
+  int patches_total = 0, mirrored = 0;
+  for (const Mesh& mesh : meshes) {
+    std::map<std::pair<int, int>, Patch> patches;
+    for (const auto& face : mesh.faces) {
+      const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(face[0])];
+      const Eigen::Vector3d& b = mesh.vertices[static_cast<std::size_t>(face[1])];
+      const Eigen::Vector3d& c = mesh.vertices[static_cast<std::size_t>(face[2])];
+      const Eigen::Vector3d normal = (b - a).cross(c - a);
+      if (normal.z() <= 0.0 || a.z() != 0.0) continue;  // the tops only
+      top_area += 0.5 * normal.z();
+      const Eigen::Vector3d centroid = (a + b + c) / 3.0;
+      Patch& patch = patches[{static_cast<int>(std::floor((centroid.x() - min.x()) / 4.0)),
+                              static_cast<int>(std::floor((centroid.y() - min.y()) / 4.0))}];
+      ++patch.faces;
+      for (const int v : face) {
+        const Eigen::Vector2d uv = mesh.texcoords[static_cast<std::size_t>(v)];
+        const Eigen::Vector3d& p = mesh.vertices[static_cast<std::size_t>(v)];
+        patch.u_min = std::min(patch.u_min, uv.x());
+        patch.u_max = std::max(patch.u_max, uv.x());
+        patch.v_min = std::min(patch.v_min, uv.y());
+        patch.v_max = std::max(patch.v_max, uv.y());
+        if (p.x() < patch.x_min) {
+          patch.x_min = p.x();
+          patch.u_at_x_min = uv.x();
+        }
+      }
+    }
+    EXPECT_FALSE(patches.empty()) << "every variant is used";
+    for (const auto& [index, patch] : patches) {
+      EXPECT_EQ(patch.u_min, 0.0);
+      EXPECT_EQ(patch.u_max, 1.0);
+      EXPECT_EQ(patch.v_min, 0.0);
+      EXPECT_EQ(patch.v_max, 1.0);
+      mirrored += patch.u_at_x_min > 0.5 ? 1 : 0;
+    }
+    patches_total += static_cast<int>(patches.size());
+  }
+  EXPECT_NEAR(top_area, 40.0 * 36.0, 1e-9);
+  EXPECT_EQ(patches_total, 90);
+  EXPECT_GT(mirrored, 0);
+  EXPECT_LT(mirrored, 90);
 }
 
 // The Wageningen garden against its source map, read here independently of the importer.

@@ -1,6 +1,9 @@
 #include "trimbot/garden/object_mesh.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "trimbot/common/random.h"
 #include "trimbot/garden/conditions.h"
@@ -166,6 +169,45 @@ Mesh BoxMesh(const Eigen::Vector3d& size, double tile) {
     Quad(mesh, first, first + 1, first + 2, first + 3);
   }
   return mesh;
+}
+
+std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& max, double tile, std::uint64_t seed) {
+  const int columns = std::max(1, static_cast<int>(std::ceil((max.x() - min.x()) / tile - 1e-9)));
+  const int rows = std::max(1, static_cast<int>(std::ceil((max.y() - min.y()) / tile - 1e-9)));
+  const auto pick = [&](const char* what, long i, long j) {
+    return SplitMix64(StreamSeed(seed, what) ^ SplitMix64(static_cast<std::uint64_t>(i) * 0x9E3779B1ULL +
+                                                           static_cast<std::uint64_t>(j)));
+  };
+  std::vector<Mesh> meshes(kGroundVariants);
+  for (int j = 0; j < rows; ++j) {
+    const bool mirror_v = (pick("lawn/row", j, 0) & 1U) != 0;
+    for (int i = 0; i < columns; ++i) {
+      const bool mirror_u = (pick("lawn/column", i, 0) & 1U) != 0;
+      Mesh& mesh = meshes[pick("lawn/variant", i, j) % kGroundVariants];
+      const double x0 = min.x() + i * tile, y0 = min.y() + j * tile, x1 = x0 + tile, y1 = y0 + tile, z = -0.01;
+      // Top: the whole variant, mirrored as drawn; sides and bottom close the slab (MuJoCo wants
+      // meshes with a volume) and are never seen.
+      const double u0 = mirror_u ? 1.0 : 0.0, v0 = mirror_v ? 1.0 : 0.0;
+      const std::array<std::array<Eigen::Vector3d, 4>, 6> quads = {{
+          {{{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}}},  // top, seen from above
+          {{{x0, y0, z}, {x0, y1, z}, {x1, y1, z}, {x1, y0, z}}},  // bottom, seen from below
+          {{{x0, y0, z}, {x1, y0, z}, {x1, y0, 0}, {x0, y0, 0}}},  // -y side
+          {{{x1, y1, z}, {x0, y1, z}, {x0, y1, 0}, {x1, y1, 0}}},  // +y side
+          {{{x0, y1, z}, {x0, y0, z}, {x0, y0, 0}, {x0, y1, 0}}},  // -x side
+          {{{x1, y0, z}, {x1, y1, z}, {x1, y1, 0}, {x1, y0, 0}}},  // +x side
+      }};
+      for (std::size_t q = 0; q < quads.size(); ++q) {
+        const int corner = static_cast<int>(mesh.vertices.size());
+        for (const auto& p : quads[q]) {
+          mesh.vertices.push_back(p);
+          mesh.texcoords.emplace_back(q == 0 ? Eigen::Vector2d(std::abs(u0 - (p.x() - x0) / tile), std::abs(v0 - (p.y() - y0) / tile))
+                                             : Eigen::Vector2d(0.0, 0.0));
+        }
+        Quad(mesh, corner, corner + 1, corner + 2, corner + 3);
+      }
+    }
+  }
+  return meshes;
 }
 
 Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth) {

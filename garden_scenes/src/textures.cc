@@ -2,7 +2,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "trimbot/common/random.h"
@@ -266,8 +269,13 @@ double TileSize(Material m) {
   }
 }
 
-cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
-  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material)));
+bool IsGround(Material m) {
+  return m == Material::kGrass || m == Material::kGravel || m == Material::kSoil || m == Material::kPavement;
+}
+
+namespace {
+
+cv::Mat Tile(Material material, cv::RNG& rng, int size_px) {
   switch (material) {
     case Material::kGrass: return Grass(rng, size_px);
     case Material::kGravel: return Gravel(rng, size_px);
@@ -281,6 +289,57 @@ cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
     case Material::kStone: return Stone(rng, size_px);
   }
   return {};
+}
+
+// 1 inside, 0 in a band along the border (8 % of the side), a smooth ramp over the next 8 %.
+cv::Mat InteriorWeight(int size_px) {
+  cv::Mat weight(size_px, size_px, CV_32F);
+  const double band = 0.08 * size_px;
+  for (int r = 0; r < size_px; ++r) {
+    for (int c = 0; c < size_px; ++c) {
+      const double d = std::min({r, c, size_px - 1 - r, size_px - 1 - c});
+      const double t = std::clamp((d - band) / band, 0.0, 1.0);
+      weight.at<float>(r, c) = static_cast<float>(t * t * (3.0 - 2.0 * t));
+    }
+  }
+  return weight;
+}
+
+}  // namespace
+
+cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
+  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material)));
+  return Tile(material, rng, size_px);
+}
+
+cv::Mat MakeGroundVariant(Material material, std::uint64_t seed, int size_px, int k) {
+  if (!IsGround(material) || k < 0 || k >= kGroundVariants) {
+    throw std::invalid_argument("MakeGroundVariant: no variant " + std::to_string(k) + " of " + ToString(material));
+  }
+  // A tile of the variant's own seed inside, crossfaded to the base tile at the border. The blend of
+  // two independent textures would lose contrast in the ramp (by up to 1/sqrt(2)): the deviation
+  // from the mean is scaled back by 1 / sqrt((1 - w)^2 + w^2), so features are as strong there.
+  cv::Mat base, variant;
+  MakeTexture(material, seed, size_px).convertTo(base, CV_32FC3);
+  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material) + "/variant" + std::to_string(k)));
+  Tile(material, rng, size_px).convertTo(variant, CV_32FC3);
+  const cv::Mat weight = InteriorWeight(size_px);
+  const cv::Scalar mean = cv::mean(base);
+  cv::Mat out(size_px, size_px, CV_8UC3);
+  for (int r = 0; r < size_px; ++r) {
+    for (int c = 0; c < size_px; ++c) {
+      const float w = weight.at<float>(r, c);
+      const float gain = 1.0f / std::sqrt((1.0f - w) * (1.0f - w) + w * w);
+      const cv::Vec3f& b = base.at<cv::Vec3f>(r, c);
+      const cv::Vec3f& v = variant.at<cv::Vec3f>(r, c);
+      cv::Vec3b& o = out.at<cv::Vec3b>(r, c);
+      for (int ch = 0; ch < 3; ++ch) {
+        const auto m = static_cast<float>(mean[ch]);
+        o[ch] = cv::saturate_cast<uchar>(m + gain * ((1.0f - w) * (b[ch] - m) + w * (v[ch] - m)));
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace trimbot::garden

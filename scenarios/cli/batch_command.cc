@@ -18,7 +18,7 @@ void AddBatchCommands(CLI::App& app, const std::string& data_root, int& exit_cod
   auto* trials_option = run->add_option("--trials", *trials, "number of trials (default: the scenario's)")
                             ->check(CLI::PositiveNumber);
   auto* seed_option = run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
-  run->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
   run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
   run->add_option("--set", options->overrides,

@@ -19,7 +19,7 @@ void AddSweep(CLI::App& app, const std::string& data_root, int& exit_code) {
   auto* trials_option = sweep->add_option("--trials", *trials, "trials per point (default: the scenario's)")
                             ->check(CLI::PositiveNumber);
   auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
-  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
   sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
   sweep->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
     options->paths = {data_root};
@@ -45,7 +45,7 @@ void AddTune(CLI::App& app, const std::string& data_root, int& exit_code) {
   auto* trials_option = tune->add_option("--trials", *trials, "trials per evaluation (default: the scenario's)")
                             ->check(CLI::PositiveNumber);
   auto* seed_option = tune->add_option("--seed", *seed, "seed of the tuning trials (the same at every point)");
-  tune->add_option("--jobs", options->jobs, "trials in parallel (processes)")->check(CLI::PositiveNumber);
+  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
   tune->add_option("--out", options->out_dir, "output folder")->required();
   tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
   tune->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {

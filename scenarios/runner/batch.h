@@ -14,14 +14,19 @@
 //                                 summary.json is the same, byte for byte, for the same scenario and seed
 //   timing.json                   wall-clock seconds per trial
 //   trajectories.png, localization_errors.png
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
+
+// Trials run in their own processes, by default one per hardware thread.
+inline int DefaultJobs() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
 struct BatchOptions {
   std::string scenario_path;
@@ -29,7 +34,7 @@ struct BatchOptions {
   ProjectPaths paths;
   std::optional<int> trials;            // overrides the scenario's
   std::optional<std::uint64_t> seed;    // overrides the scenario's
-  int jobs = 1;
+  int jobs = DefaultJobs();
   int shard_index = 0, shard_count = 1;
   bool keep_worlds = false;             // keep each trial's composed MuJoCo world (large textures)
   std::vector<std::string> overrides;   // --set key.path=value, applied to the scenario file

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "runner/batch.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -30,7 +31,7 @@ struct SweepOptions {
   std::vector<std::string> overrides;   // --set for every point
   std::optional<int> trials;
   std::optional<std::uint64_t> seed;
-  int jobs = 1;
+  int jobs = DefaultJobs();
 };
 
 // Runs the sweep; returns 0 (a sweep reports, it does not judge). Bad input throws InputError.

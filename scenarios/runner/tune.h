@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "runner/batch.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -42,7 +43,7 @@ struct TuneOptions {
   int budget_trials = 60;              // trials for the search (fresh-seed runs not counted)
   std::optional<int> trials;           // per evaluation (default: the scenario's)
   std::optional<std::uint64_t> seed;   // tuning seeds; fresh seeds start 1,000,000 higher
-  int jobs = 1;
+  int jobs = DefaultJobs();
   std::string out_dir;
   ProjectPaths paths;
   std::vector<std::string> overrides;  // --set for every evaluation

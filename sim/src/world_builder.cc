@@ -3,7 +3,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -180,17 +183,49 @@ class MjcfEmitter {
   std::vector<std::string> joints_;
 };
 
-std::string WriteTexture(garden::Material material, std::uint64_t seed, const WorldOptions& options, const fs::path& dir) {
-  const fs::path path = dir / (garden::ToString(material) + ".png");
+// Writes the texture `name` (a material, or a ground variant: "grass_v2") into the world's folder,
+// from the cache when it is there; returns its absolute path.
+std::string WriteTexture(const std::string& name, const std::function<cv::Mat()>& make, std::uint64_t seed, int size,
+                         const WorldOptions& options, const fs::path& dir) {
+  const fs::path path = dir / (name + ".png");
+  fs::path cached;
+  if (!options.texture_cache_dir.empty()) {
+    char key[128];
+    std::snprintf(key, sizeof key, "%s_%016llx_%d_v%d.png", name.c_str(), static_cast<unsigned long long>(seed), size,
+                  garden::kTextureGeneratorVersion);
+    cached = fs::path(options.texture_cache_dir) / key;
+    std::error_code error;
+    if (fs::exists(cached, error) && fs::copy_file(cached, path, fs::copy_options::overwrite_existing, error)) {
+      return fs::absolute(path).string();
+    }
+  }
   std::vector<uchar> png;
-  // Ground tiles cover 2-4 m and are seen from 0.5 m up: they get twice the resolution.
-  const int size = garden::TileSize(material) > 1.0 ? 2 * options.texture_size : options.texture_size;
-  cv::imencode(".png", garden::MakeTexture(material, seed, size), png);
-  WriteFileAtomically(path.string(), std::string(png.begin(), png.end()));
+  cv::imencode(".png", make(), png);
+  const std::string bytes(png.begin(), png.end());
+  WriteFileAtomically(path.string(), bytes);
+  if (!cached.empty()) {
+    try {  // a cache that cannot be written only costs time
+      fs::create_directories(cached.parent_path());
+      WriteFileAtomically(cached.string(), bytes);
+    } catch (const std::exception&) {
+    }
+  }
   return fs::absolute(path).string();
 }
 
+// Ground tiles cover 2-4 m and are seen from 0.5 m up: they get twice the resolution.
+int TextureSize(garden::Material material, const WorldOptions& options) {
+  return garden::IsGround(material) ? 2 * options.texture_size : options.texture_size;
+}
+
 }  // namespace
+
+std::string DefaultTextureCacheDir() {
+  if (const char* dir = std::getenv("TRIMBOT_TEXTURE_CACHE")) return dir;
+  std::error_code error;
+  const fs::path temp = fs::temp_directory_path(error);
+  return error ? std::string() : (temp / "trimbot_texture_cache").string();
+}
 
 WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig,
                        const garden::Garden& garden, const WorldOptions& options, const std::string& output_dir) {
@@ -211,8 +246,8 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     max_render_h = std::max(max_render_h, render.height);
   }
 
-  // Materials: one texture per material the garden uses. Meshes carry their own texture
-  // coordinates (in tiles); the lawn plane repeats its texture per metre instead.
+  // Materials: one texture per material the garden uses, and the lawn's ground variants ("grass_v0"
+  // ...). Meshes carry their own texture coordinates.
   const garden::Material lawn = garden::GroundMaterial(garden.ground);
   std::set<garden::Material> materials = {lawn};
   for (const auto& path : garden.paths) materials.insert(garden::GroundMaterial(path.surface));
@@ -222,22 +257,32 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
             "rgb2=\"0.92 0.95 1.0\" width=\"256\" height=\"256\"/>\n";
   for (const auto material : materials) {
     const std::string name = garden::ToString(material);
-    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << WriteTexture(material, garden.appearance_seed, options, texture_dir)
-           << "\"/>\n"
+    const int size = TextureSize(material, options);
+    const std::string file = WriteTexture(
+        name, [&] { return garden::MakeTexture(material, garden.appearance_seed, size); }, garden.appearance_seed, size,
+        options, texture_dir);
+    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
            << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
   }
-  const double repeat = 1.0 / garden::TileSize(lawn);
-  assets << "    <material name=\"lawn\" texture=\"" << garden::ToString(lawn) << "\" texuniform=\"true\" texrepeat=\""
-         << Num(repeat) << " " << Num(repeat) << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
+  for (int k = 0; k < garden::kGroundVariants; ++k) {
+    const std::string name = garden::ToString(lawn) + "_v" + std::to_string(k);
+    const int size = TextureSize(lawn, options);
+    const std::string file = WriteTexture(
+        name, [&] { return garden::MakeGroundVariant(lawn, garden.appearance_seed, size, k); }, garden.appearance_seed,
+        size, options, texture_dir);
+    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
+           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
+  }
 
   // Garden geometry: static geoms in the world body; objects and paths are meshes.
   std::ostringstream world;
   const double margin = 60.0;  // the lawn runs on past the garden so the horizon is not sky
   const garden::SurfaceProperties ground = garden::PropertiesOf(garden.ground);
-  world << "    <geom name=\"garden/ground\" class=\"garden\" type=\"plane\" pos=\"" << Num(garden.centre.x()) << " "
-        << Num(garden.centre.y()) << " 0\" size=\"" << Num(garden.size.x() / 2 + margin) << " "
-        << Num(garden.size.y() / 2 + margin) << " 0.1\" material=\"lawn\" friction=\"" << Num(ground.friction)
-        << " 0.005 0.0001\"/>\n";
+  // The ground collides as a plane and is drawn as the lawn's patches on it (group 3: not drawn).
+  const Eigen::Vector2d half(garden.size.x() / 2 + margin, garden.size.y() / 2 + margin);
+  world << "    <geom name=\"garden/ground\" class=\"garden\" group=\"3\" type=\"plane\" pos=\"" << Num(garden.centre.x())
+        << " " << Num(garden.centre.y()) << " 0\" size=\"" << Num(half.x()) << " " << Num(half.y()) << " 0.1\" friction=\""
+        << Num(ground.friction) << " 0.005 0.0001\"/>\n";
   spec.labels.push_back({"garden/ground", ObjectClass::kGround, garden::kGroundObjectId, true, garden.ground});
   auto emit_mesh = [&](const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose,
                        const std::string& material, const std::string& geom_class) {
@@ -253,6 +298,18 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     world << "    <geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"mesh\" mesh=\"" << name
           << "\" " << PoseAttributes(iso) << " material=\"" << material << "\"/>\n";
   };
+  // The lawn's variants at twice the tile: 4 mm a texel for grass, the scale the lawn had as a
+  // plane (MuJoCo's texrepeat on a plane counts repeats per 2 m) and that the localization figures
+  // were measured at; at 2 mm the blades are finer than a camera pixel and the lawn renders smooth.
+  const std::vector<garden::Mesh> lawn_meshes = garden::LawnMeshes(
+      garden.centre - half, garden.centre + half, 2.0 * garden::TileSize(lawn), garden.appearance_seed);
+  for (std::size_t k = 0; k < lawn_meshes.size(); ++k) {
+    if (lawn_meshes[k].faces.empty()) continue;
+    const std::string name = "garden/lawn_v" + std::to_string(k);
+    emit_mesh(name, lawn_meshes[k], Eigen::Matrix4d::Identity(), garden::ToString(lawn) + "_v" + std::to_string(k),
+              "garden_surface");
+    spec.labels.push_back({name, ObjectClass::kGround, garden::kGroundObjectId, true, garden.ground});
+  }
   // Paths and beds are flush with the lawn: drawn as 2 mm slabs that do not collide (a slab edge
   // would stop a wheel); the simulator finds the surface under a wheel from the garden's paths.
   for (size_t i = 0; i < garden.paths.size(); ++i) {

@@ -23,6 +23,13 @@ struct Mesh {
 
 // Box of the given full size, base on z = 0, textured `tile` metres per texture repeat.
 Mesh BoxMesh(const Eigen::Vector3d& size, double tile);
+// The lawn, in the map frame, as one mesh per ground variant (textures.h): square patches of
+// `tile` metres covering [min, max] (grown to whole patches), each a 1 cm slab whose top (z = 0)
+// shows its variant once (texture coordinates 0..1). Variants are drawn per patch and whole
+// columns and rows of patches are mirrored, all by `seed`; mirroring whole columns and rows keeps
+// neighbours meeting on the same border texels, so the lawn has no seams and no period shorter
+// than the garden.
+std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& max, double tile, std::uint64_t seed);
 // Mesh of a garden object in its own frame; `growth` in 0..1 (see Conditions).
 Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth);
 // Pose of the object frame in the map frame.

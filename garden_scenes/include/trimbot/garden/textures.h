@@ -20,7 +20,19 @@ Material MaterialOf(ObjectClass c);
 // Metres one texture tile covers on a surface.
 double TileSize(Material m);
 
-// Square BGR 8-bit image, the same for the same seed.
+// Ground surfaces (grass, gravel, soil, pavement) are not one tile repeated: the lawn is laid in
+// tile-sized patches, each showing one of kGroundVariants variants of the surface's tile chosen by
+// the garden's seed (garden/object_mesh.h LawnMeshes). The variants share a border band with the
+// base tile (the same texels) and differ inside, so any arrangement of them is seamless.
+constexpr int kGroundVariants = 4;
+bool IsGround(Material m);
+
+// Changes whenever a generator's output changes (caches of generated textures are keyed by it).
+constexpr int kTextureGeneratorVersion = 3;
+
+// Square BGR 8-bit image, the same for the same seed (for a ground material: the base tile).
 cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px);
+// Variant k (0 .. kGroundVariants - 1) of a ground material's tile.
+cv::Mat MakeGroundVariant(Material material, std::uint64_t seed, int size_px, int k);
 
 }  // namespace trimbot::garden

@@ -17,6 +17,9 @@ struct Pose2D {
   double x = 0.0, y = 0.0, yaw = 0.0;
 };
 
+// $TRIMBOT_TEXTURE_CACHE if set, else trimbot_texture_cache in the system's temporary folder.
+std::string DefaultTextureCacheDir();
+
 struct WorldOptions {
   double timestep = 0.002;        // s, fixed physics step
   Pose2D start;                   // base_link in the map frame
@@ -24,6 +27,10 @@ struct WorldOptions {
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;
   int msaa_samples = 4;           // multisample anti-aliasing; 0 renders twice as fast, with jagged edges
+  // Generated textures are kept here by (material, garden seed, size, generator version) and
+  // copied into each world: every trial of a batch, and every test, uses the same few (seconds
+  // to generate and encode). Empty: always generate.
+  std::string texture_cache_dir = DefaultTextureCacheDir();
 };
 
 // What the label images report for a geom.
