@@ -148,6 +148,24 @@ TEST(RobotStack, PoseFixesAreUsedOnlyWhenASourceIsConfigured) {
   }
 }
 
+// What the stack asks of the ring: nothing without a component that uses images; with local
+// fusion, every camera at the calibrated resolution (stereo rectifies with it) when a cloud is due.
+TEST(RobotStack, AsksTheRingOnlyForWhatItsComponentsUse) {
+  StackParameters parameters = StackParameters::Load(Files().stack_parameters);
+  parameters.localization = LocalizationSource::kNone;
+  parameters.local_fusion.enabled = false;
+  {
+    RobotStack stack(Files(), parameters, 1);
+    EXPECT_TRUE(stack.RingRequestAt(0.0).empty());
+  }
+  parameters.local_fusion.enabled = true;
+  RobotStack stack(Files(), parameters, 1);
+  const messages::RingRequest request = stack.RingRequestAt(0.0);
+  ASSERT_EQ(request.cameras.size(), 10u);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(request.cameras[static_cast<std::size_t>(i)], i);
+  EXPECT_EQ(request.resolution_scale, 1.0);
+}
+
 // A copy of robot/config/stack.yaml with one line changed (or removed when `replacement` is empty).
 std::string Variant(const std::string& name, const std::string& pattern, const std::string& replacement) {
   std::ifstream in(Files().stack_parameters);

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -79,20 +81,30 @@ nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
       request.cameras = mine;
     }
     requests.push_back(request);
-    simulators.back()->CaptureRing(request, false);  // warm-up: shader compilation, texture upload
   }
-  const sim::SimulatorTimings before = simulators[0]->timings();
-  const auto start = Clock::now();
-  const auto render = [&](int r) {
-    for (int i = 0; i < options.frames; ++i) simulators[static_cast<std::size_t>(r)]->CaptureRing(requests[static_cast<std::size_t>(r)], false);
+  // Each renderer's OpenGL context is used on one thread only: warm-up (shader compilation,
+  // texture upload) and frames; the clock starts when every renderer is warm.
+  std::mutex mutex;
+  std::condition_variable all_warm;
+  int warm = 0;
+  sim::SimulatorTimings before;
+  Clock::time_point start;
+  const auto render = [&](std::size_t r) {
+    simulators[r]->CaptureRing(requests[r], false);
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      if (++warm == renderers) {
+        before = simulators[0]->timings();
+        start = Clock::now();
+        all_warm.notify_all();
+      }
+      all_warm.wait(lock, [&] { return warm == renderers; });
+    }
+    for (int i = 0; i < options.frames; ++i) simulators[r]->CaptureRing(requests[r], false);
   };
-  if (v.two_threads) {
-    std::thread second(render, 1);
-    render(0);
-    second.join();
-  } else {
-    render(0);
-  }
+  std::vector<std::thread> threads;
+  for (int r = 0; r < renderers; ++r) threads.emplace_back(render, static_cast<std::size_t>(r));
+  for (auto& thread : threads) thread.join();
   const double ring_ms = 1000.0 * Seconds(start) / options.frames;
   std::size_t cameras = 0;
   for (const auto& request : requests) cameras += request.cameras.size();

@@ -117,6 +117,7 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   cv::flip(rgb_up, *rgb, 0);
   if (!segmentation) timings_.readback += SecondsSince(start);
   if (depth != nullptr) {
+    const auto depth_start = Clock::now();
     const cv::Mat depth_up(camera.render.height, camera.render.width, CV_32F, gl_->depth.data());
     cv::Mat buffer;
     cv::flip(depth_up, buffer, 0);
@@ -131,6 +132,7 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
         out[c] = in[c] >= 1.0f ? 0.0f : static_cast<float>(znear / (1.0 - in[c] * (1.0 - znear / zfar)));
       }
     }
+    timings_.ground_truth += SecondsSince(depth_start);
   }
 }
 

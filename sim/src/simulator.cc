@@ -281,6 +281,12 @@ RingCapture Simulator::CaptureRing(bool with_ground_truth) { return CaptureRing(
 
 RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool with_ground_truth) {
   if (!impl_->renderer) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
+  for (std::size_t i = 0; i < request.cameras.size(); ++i) {
+    const int camera = request.cameras[i];
+    if (camera < 0 || camera >= rig_.size() || (i > 0 && camera <= request.cameras[i - 1])) {
+      throw std::invalid_argument("CaptureRing: the request's cameras must be rig indices, ascending, each once");
+    }
+  }
   World& world = *impl_->world;
   mj_forward(world.model(), world.data());  // kinematics at the current time
   RingCapture capture;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iomanip>
 #include <set>
@@ -194,9 +195,13 @@ std::string WriteTexture(const std::string& name, const std::function<cv::Mat()>
     std::snprintf(key, sizeof key, "%s_%016llx_%d_v%d.png", name.c_str(), static_cast<unsigned long long>(seed), size,
                   garden::kTextureGeneratorVersion);
     cached = fs::path(options.texture_cache_dir) / key;
-    std::error_code error;
-    if (fs::exists(cached, error) && fs::copy_file(cached, path, fs::copy_options::overwrite_existing, error)) {
-      return fs::absolute(path).string();
+    std::ifstream in(cached, std::ios::binary);
+    if (in) {
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!bytes.empty()) {
+        WriteFileAtomically(path.string(), bytes);
+        return fs::absolute(path).string();
+      }
     }
   }
   std::vector<uchar> png;

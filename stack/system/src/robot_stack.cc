@@ -187,7 +187,7 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
   if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
     messages::RingRequest stereo;
     for (int i = 0; i < components_->rig.size(); ++i) stereo.cameras.push_back(i);
-    stereo.resolution_scale = parameters_.local_fusion.image_scale;
+    stereo.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
     request = messages::Merge(request, stereo);
   }
   return request;

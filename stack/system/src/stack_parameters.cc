@@ -173,7 +173,6 @@ void Read(Reader& r, StackParameters& s) {
       f.Number("interval", &p.interval, 0.05, 3600.0, "s");
       f.Integer("stride", &p.stride, 1, 64);
       f.Number("ground_keep", &p.ground_keep, 0.0, 1.0);
-      f.Number("image_scale", &p.image_scale, 0.05, 1.0);
     });
   });
 }

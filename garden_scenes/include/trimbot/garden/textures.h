@@ -20,9 +20,9 @@ Material MaterialOf(ObjectClass c);
 // Metres one texture tile covers on a surface.
 double TileSize(Material m);
 
-// Ground surfaces (grass, gravel, soil, pavement) are not one tile repeated: the lawn is laid in
-// tile-sized patches, each showing one of kGroundVariants variants of the surface's tile chosen by
-// the garden's seed (garden/object_mesh.h LawnMeshes). The variants share a border band with the
+// The lawn is not one tile repeated: it is laid in patches (twice the tile: sim/world_builder),
+// each showing one of kGroundVariants variants of its surface's tile chosen by the garden's seed
+// (garden/object_mesh.h LawnMeshes); paths still repeat the base tile. The variants share a border band with the
 // base tile (the same texels) and differ inside, so any arrangement of them is seamless.
 constexpr int kGroundVariants = 4;
 bool IsGround(Material m);

@@ -2,8 +2,8 @@
 // The cameras' read noise: additive Gaussian per pixel and channel. Drawing a million Gaussian
 // samples per full-resolution image cost more than distorting it (4 ms a camera); instead the
 // simulator draws a bank of unit samples once, from its seed, and each image takes a window of it
-// chosen by the image's own stream seed, scaled by sigma. Windows start anywhere in a bank four
-// times the largest image, so neighbouring images' noise is not aligned.
+// chosen by the image's own stream seed, scaled by sigma. Windows start anywhere in a bank of 4M
+// samples (nearly four full 752x480 RGB images), so neighbouring images' noise is not aligned.
 #include <opencv2/core.hpp>
 
 #include <cstdint>

@@ -20,10 +20,10 @@ namespace trimbot::sim {
 
 // Wall-clock seconds spent per rendering stage since the renderer was made.
 struct RenderTimings {
-  double draw = 0.0;        // OpenGL drawing (scene update, shadows, rasterization, MSAA resolve)
-  double readback = 0.0;    // reading the pixels back and flipping them upright
+  double draw = 0.0;        // OpenGL drawing (scene update, shadow map, rasterization)
+  double readback = 0.0;    // the MSAA resolve, reading the pixels back, flipping them upright
   double distortion = 0.0;  // resampling the pinhole render into the calibrated (distorted) camera
-  double ground_truth = 0.0;  // depth conversion and the label pass, when asked for
+  double ground_truth = 0.0;  // depth to metres, the label pass and their remaps, when asked for
   long images = 0;          // camera images rendered
 };
 

@@ -18,7 +18,6 @@ struct LocalFusionOptions {
   double interval = 1.0;      // s between clouds
   int stride = 4;             // pixel stride of the stereo clouds (every pixel: ~500k points a ring)
   double ground_keep = 0.02;  // fraction of ground points kept (the lawn would dominate the fit)
-  double image_scale = 0.5;   // resolution the ring is asked for (every stereo pair)
 };
 
 // One registration of a cloud to the previous one. Relative poses are of the current base_link in

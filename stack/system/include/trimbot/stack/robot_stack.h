@@ -27,9 +27,8 @@ namespace trimbot::stack {
 enum class MissionState { kIdle, kDriving, kDone, kFailed };
 const char* ToString(MissionState state);
 
-// Wall-clock seconds spent in each part of the stack since it started (not deterministic: for
-// timing reports only).
-// Wall-clock seconds per component since the start (for the run's timing report).
+// Wall-clock seconds per component since the start (not deterministic: for the run's timing
+// report only).
 struct StackTimings {
   double ekf = 0.0;                  // IMU, wheel ticks and fixes into the EKF, wheel odometry
   double visual_localization = 0.0;  // whole frames (split by stage in visual_frames)
