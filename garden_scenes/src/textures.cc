@@ -305,26 +305,9 @@ cv::Mat InteriorWeight(int size_px) {
   return weight;
 }
 
-}  // namespace
-
-cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
-  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material)));
-  return Tile(material, rng, size_px);
-}
-
-cv::Mat MakeGroundVariant(Material material, std::uint64_t seed, int size_px, int k) {
-  if (!IsGround(material) || k < 0 || k >= kGroundVariants) {
-    throw std::invalid_argument("MakeGroundVariant: no variant " + std::to_string(k) + " of " + ToString(material));
-  }
-  // A tile of the variant's own seed inside, crossfaded to the base tile at the border. The blend of
-  // two independent textures would lose contrast in the ramp (by up to 1/sqrt(2)): the deviation
-  // from the mean is scaled back by 1 / sqrt((1 - w)^2 + w^2), so features are as strong there.
-  cv::Mat base, variant;
-  MakeTexture(material, seed, size_px).convertTo(base, CV_32FC3);
-  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material) + "/variant" + std::to_string(k)));
-  Tile(material, rng, size_px).convertTo(variant, CV_32FC3);
-  const cv::Mat weight = InteriorWeight(size_px);
-  const cv::Scalar mean = cv::mean(base);
+// The variant where `weight` is 1, the base where it is 0, contrast kept in between.
+cv::Mat Crossfade(const cv::Mat& base, const cv::Mat& variant, const cv::Mat& weight, const cv::Scalar& mean) {
+  const int size_px = base.rows;
   cv::Mat out(size_px, size_px, CV_8UC3);
   for (int r = 0; r < size_px; ++r) {
     for (int c = 0; c < size_px; ++c) {
@@ -340,6 +323,32 @@ cv::Mat MakeGroundVariant(Material material, std::uint64_t seed, int size_px, in
     }
   }
   return out;
+}
+
+}  // namespace
+
+cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
+  cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material)));
+  return Tile(material, rng, size_px);
+}
+
+std::vector<cv::Mat> MakeGroundVariants(Material material, std::uint64_t seed, int size_px) {
+  if (!IsGround(material)) throw std::invalid_argument("MakeGroundVariants: " + ToString(material) + " is not a ground");
+  // Each a tile of the variant's own seed inside, crossfaded to the base tile at the border. The
+  // blend of two independent textures would lose contrast in the ramp (by up to 1/sqrt(2)): the
+  // deviation from the mean is scaled back by 1 / sqrt((1 - w)^2 + w^2), so features are as strong there.
+  cv::Mat base;
+  MakeTexture(material, seed, size_px).convertTo(base, CV_32FC3);
+  const cv::Mat weight = InteriorWeight(size_px);
+  const cv::Scalar mean = cv::mean(base);
+  std::vector<cv::Mat> variants;
+  for (int k = 0; k < kGroundVariants; ++k) {
+    cv::Mat variant;
+    cv::RNG rng(StreamSeed(seed, "texture/" + ToString(material) + "/variant" + std::to_string(k)));
+    Tile(material, rng, size_px).convertTo(variant, CV_32FC3);
+    variants.push_back(Crossfade(base, variant, weight, mean));
+  }
+  return variants;
 }
 
 }  // namespace trimbot::garden

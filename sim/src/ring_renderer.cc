@@ -91,10 +91,6 @@ const RingRenderer::CameraSetup& RingRenderer::Setup(int index, double resolutio
   return setups_.emplace(key, std::move(setup)).first->second;
 }
 
-const robot::PinholeRadtan& RingRenderer::camera_model(int index, double resolution_scale) {
-  return Setup(index, resolution_scale).model;
-}
-
 void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool segmentation, cv::Mat* rgb,
                               cv::Mat* depth) {
   const mjModel* m = world_.model();

@@ -223,6 +223,39 @@ int TextureSize(garden::Material material, const WorldOptions& options) {
   return garden::IsGround(material) ? 2 * options.texture_size : options.texture_size;
 }
 
+// The MJCF assets of the garden's textures and their materials, the textures written to
+// `texture_dir`: one per material the paths and objects use, and the lawn's ground variants
+// ("grass_v0" ...; the lawn's base tile only if a path shows it). Meshes carry their own texture
+// coordinates.
+std::string TextureAssets(const garden::Garden& garden, const WorldOptions& options, const fs::path& texture_dir) {
+  const garden::Material lawn = garden::GroundMaterial(garden.ground);
+  std::set<garden::Material> materials;
+  for (const auto& path : garden.paths) materials.insert(garden::GroundMaterial(path.surface));
+  for (const auto& object : garden.objects) materials.insert(garden::MaterialOf(object.object_class));
+  std::ostringstream assets;
+  assets << "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.55 0.70 0.92\" "
+            "rgb2=\"0.92 0.95 1.0\" width=\"256\" height=\"256\"/>\n";
+  // A texture and the material of the same name showing it.
+  const auto add_texture = [&](const std::string& name, int size, const std::function<cv::Mat()>& make) {
+    const std::string file = WriteTexture(name, make, garden.appearance_seed, size, options, texture_dir);
+    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
+           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
+  };
+  for (const auto material : materials) {
+    const int size = TextureSize(material, options);
+    add_texture(garden::ToString(material), size, [&] { return garden::MakeTexture(material, garden.appearance_seed, size); });
+  }
+  const int lawn_size = TextureSize(lawn, options);
+  std::vector<cv::Mat> variants;  // made once, and only when one of them is not in the cache
+  for (int k = 0; k < garden::kGroundVariants; ++k) {
+    add_texture(garden::ToString(lawn) + "_v" + std::to_string(k), lawn_size, [&] {
+      if (variants.empty()) variants = garden::MakeGroundVariants(lawn, garden.appearance_seed, lawn_size);
+      return variants[static_cast<std::size_t>(k)];
+    });
+  }
+  return assets.str();
+}
+
 }  // namespace
 
 std::string DefaultTextureCacheDir() {
@@ -251,33 +284,9 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     max_render_h = std::max(max_render_h, render.height);
   }
 
-  // Materials: one texture per material the garden uses, and the lawn's ground variants ("grass_v0"
-  // ...). Meshes carry their own texture coordinates.
   const garden::Material lawn = garden::GroundMaterial(garden.ground);
-  std::set<garden::Material> materials = {lawn};
-  for (const auto& path : garden.paths) materials.insert(garden::GroundMaterial(path.surface));
-  for (const auto& object : garden.objects) materials.insert(garden::MaterialOf(object.object_class));
   std::ostringstream assets;
-  assets << "    <texture name=\"sky\" type=\"skybox\" builtin=\"gradient\" rgb1=\"0.55 0.70 0.92\" "
-            "rgb2=\"0.92 0.95 1.0\" width=\"256\" height=\"256\"/>\n";
-  for (const auto material : materials) {
-    const std::string name = garden::ToString(material);
-    const int size = TextureSize(material, options);
-    const std::string file = WriteTexture(
-        name, [&] { return garden::MakeTexture(material, garden.appearance_seed, size); }, garden.appearance_seed, size,
-        options, texture_dir);
-    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
-           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
-  }
-  for (int k = 0; k < garden::kGroundVariants; ++k) {
-    const std::string name = garden::ToString(lawn) + "_v" + std::to_string(k);
-    const int size = TextureSize(lawn, options);
-    const std::string file = WriteTexture(
-        name, [&] { return garden::MakeGroundVariant(lawn, garden.appearance_seed, size, k); }, garden.appearance_seed,
-        size, options, texture_dir);
-    assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
-           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
-  }
+  assets << TextureAssets(garden, options, texture_dir);
 
   // Garden geometry: static geoms in the world body; objects and paths are meshes.
   std::ostringstream world;

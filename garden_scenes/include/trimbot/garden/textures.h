@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "trimbot/garden/object_class.h"
 
@@ -32,7 +33,7 @@ constexpr int kTextureGeneratorVersion = 3;
 
 // Square BGR 8-bit image, the same for the same seed (for a ground material: the base tile).
 cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px);
-// Variant k (0 .. kGroundVariants - 1) of a ground material's tile.
-cv::Mat MakeGroundVariant(Material material, std::uint64_t seed, int size_px, int k);
+// The kGroundVariants variants of a ground material's tile (the base tile made once for all).
+std::vector<cv::Mat> MakeGroundVariants(Material material, std::uint64_t seed, int size_px);
 
 }  // namespace trimbot::garden

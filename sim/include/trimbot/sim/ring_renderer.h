@@ -37,8 +37,6 @@ class RingRenderer {
   // Renders rig camera `index` at `resolution_scale` of its calibrated size (0.5 = half) in the
   // world's current state (call mj_forward first).
   RenderedView Render(int index, double resolution_scale, bool with_ground_truth);
-  // The camera model the images at that scale follow (the calibration, scaled).
-  const robot::PinholeRadtan& camera_model(int index, double resolution_scale);
   const RenderTimings& timings() const { return timings_; }
 
  private:
