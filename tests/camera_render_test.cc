@@ -221,14 +221,15 @@ TEST(RingRequest, RendersOnlyTheNamedCamerasAtTheAskedResolution) {
 }
 
 // Read noise from the bank: zero mean, the asked sigma, the same image seed the same noise, another
-// seed other noise; saturates instead of wrapping.
+// seed other noise; the signal scaled by the exposure; saturates instead of wrapping, and clips the
+// noise of a pixel the exposure saturated.
 TEST(ReadNoise, HasTheAskedSigmaAndIsReproducible) {
   const ReadNoise noise(5);
-  cv::Mat a(240, 376, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::Mat a(240, 376, CV_8UC3, cv::Scalar(64, 64, 64));
   cv::Mat b = a.clone(), c = a.clone();
-  noise.Apply(a, 2.0, 11);
-  noise.Apply(b, 2.0, 11);
-  noise.Apply(c, 2.0, 12);
+  noise.ReadOut(a, 2.0, 2.0, 11);
+  noise.ReadOut(b, 2.0, 2.0, 11);
+  noise.ReadOut(c, 2.0, 2.0, 12);
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(a, c, cv::NORM_L1), 0.0);
   cv::Scalar mean, sigma;
@@ -236,11 +237,40 @@ TEST(ReadNoise, HasTheAskedSigmaAndIsReproducible) {
   EXPECT_NEAR(mean[0], 128.0, 0.05);
   EXPECT_NEAR(sigma[0], 2.0, 0.1);  // rounding to grey levels adds 1/12 to the variance
   cv::Mat white(10, 10, CV_8UC3, cv::Scalar(255, 255, 255));
-  noise.Apply(white, 50.0, 3);
+  noise.ReadOut(white, 1.0, 50.0, 3);
   double lowest = 0.0;
   cv::minMaxLoc(white.reshape(1), &lowest);
   EXPECT_LT(lowest, 255.0);
   EXPECT_GT(cv::mean(white)[0], 200.0) << "saturated at 255, not wrapped to dark";
+  cv::Mat overexposed(10, 10, CV_8UC3, cv::Scalar(200, 200, 200));
+  noise.ReadOut(overexposed, 2.0, 2.0, 4);
+  cv::minMaxLoc(overexposed.reshape(1), &lowest);
+  EXPECT_EQ(lowest, 255.0) << "400 grey levels of signal stay clipped at 255 with noise of 2";
+}
+
+TEST(FrustumCulling, DrawsTheSameImagesWithFewerGeoms) {
+  RingCapture captures[2];
+  SimulatorTimings timings[2];
+  for (const bool culling : {false, true}) {
+    SimulatorConfig config = TestConfig(testing::TestLawn(), culling ? "culling_on" : "culling_off", true);
+    config.conditions.time_of_day = 18.5;
+    config.resolution_scale = 0.5;
+    config.frustum_culling = culling;
+    Simulator simulator(config);
+    captures[culling] = simulator.CaptureRing(true);
+    timings[culling] = simulator.timings();
+  }
+  EXPECT_EQ(timings[0].geoms_culled, 0);
+  EXPECT_GT(timings[1].geoms_culled, timings[1].geoms_drawn / 4) << "most cameras see part of the garden";
+  EXPECT_EQ(timings[1].geoms_drawn + timings[1].geoms_culled, timings[0].geoms_drawn);
+  ASSERT_EQ(captures[0].frame.images.size(), captures[1].frame.images.size());
+  for (std::size_t i = 0; i < captures[0].frame.images.size(); ++i) {
+    EXPECT_TRUE(captures[0].frame.images[i].data == captures[1].frame.images[i].data) << "camera " << i;
+    const RenderedView& off = captures[0].truth.views[i];
+    const RenderedView& on = captures[1].truth.views[i];
+    EXPECT_EQ(cv::norm(off.object_id, on.object_id, cv::NORM_INF), 0.0) << "camera " << i;
+    EXPECT_EQ(cv::norm(off.depth, on.depth, cv::NORM_INF), 0.0) << "camera " << i;
+  }
 }
 
 TEST(Determinism, SameSeedSameBytes) {

@@ -8,6 +8,7 @@
 #include "trimbot/sim/arm_controller.h"
 #include "trimbot/sim/base_controller.h"
 #include "trimbot/sim/camera_exposure.h"
+#include "trimbot/sim/camera_noise.h"
 #include "trimbot/sim/imu_model.h"
 #include "trimbot/sim/wheel_encoder_model.h"
 
@@ -146,31 +147,36 @@ TEST(ArmController, VelocityModeIntegratesAndClampsToLimits) {
 
 // Evening: a dark ground under a bright sky. The metering window (the ground) is brought to the
 // target by a longer exposure first, then by gain; a bright scene is darkened; off leaves it alone.
+// The read-out scales the image by what was chosen and clips at 255.
 TEST(AutoExposure, BringsTheGroundToTheTargetByExposureThenGain) {
   robot::AutoExposure ae;
   ae.target_mean = 100.0;
   ae.metering_top = 0.5;
   ae.max_exposure_factor = 2.0;
   ae.max_gain = 4.0;
+  const ReadNoise noiseless(1, 16);
   cv::Mat image(100, 50, CV_8UC3, cv::Scalar(200, 200, 200));            // sky
   image.rowRange(50, 100).setTo(cv::Scalar(20, 30, 40));                 // ground, mean 30
-  const ExposureResult dark = ApplyAutoExposure(image, ae);
+  const ExposureResult dark = MeterExposure(image, ae);
   EXPECT_NEAR(dark.exposure_factor, 2.0, 1e-9);
   EXPECT_NEAR(dark.gain, 100.0 / 30.0 / 2.0, 1e-9);
+  noiseless.ReadOut(image, dark.exposure_factor * dark.gain, 0.0, 0);
   const cv::Scalar ground = cv::mean(image.rowRange(50, 100));
   EXPECT_NEAR((ground[0] + ground[1] + ground[2]) / 3.0, 100.0, 1.0);
   EXPECT_EQ(image.at<cv::Vec3b>(0, 0)[0], 255);                          // the sky saturates
 
   cv::Mat bright(100, 50, CV_8UC3, cv::Scalar(220, 220, 220));
-  const ExposureResult shorter = ApplyAutoExposure(bright, ae);
+  const ExposureResult shorter = MeterExposure(bright, ae);
   EXPECT_NEAR(shorter.exposure_factor, 0.5, 1e-9);                       // limited at 1/2
   EXPECT_EQ(shorter.gain, 1.0);
+  noiseless.ReadOut(bright, shorter.exposure_factor * shorter.gain, 0.0, 0);
   EXPECT_EQ(bright.at<cv::Vec3b>(99, 0)[0], 110);
 
   ae.enabled = false;
-  cv::Mat untouched(10, 10, CV_8UC3, cv::Scalar(20, 20, 20));
-  EXPECT_EQ(ApplyAutoExposure(untouched, ae).gain, 1.0);
-  EXPECT_EQ(untouched.at<cv::Vec3b>(5, 5)[0], 20);
+  const cv::Mat untouched(10, 10, CV_8UC3, cv::Scalar(20, 20, 20));
+  const ExposureResult off = MeterExposure(untouched, ae);
+  EXPECT_EQ(off.gain, 1.0);
+  EXPECT_EQ(off.exposure_factor, 1.0);
 }
 
 }  // namespace

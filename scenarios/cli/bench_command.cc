@@ -25,7 +25,8 @@ using Clock = std::chrono::steady_clock;
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4, bool shadows = true) {
+sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4, bool shadows = true,
+                            bool culling = true) {
   WorldSetup world;
   world.garden = options.garden;
   world.seed = 7;
@@ -35,6 +36,7 @@ sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double sc
   config.render_cameras = cameras;
   config.resolution_scale = scale;
   config.msaa_samples = msaa;
+  config.frustum_culling = culling;
   return config;
 }
 
@@ -47,6 +49,7 @@ struct RenderVariant {
   bool shadows = true;
   bool left_only = false;  // the left camera of each pair (what localization asks for)
   bool two_threads = false;
+  bool culling = true;  // each camera draws only the geoms that can show in it
 };
 
 messages::RingRequest RequestFor(const sim::Simulator& simulator, const RenderVariant& v) {
@@ -73,7 +76,7 @@ nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
   std::vector<std::unique_ptr<sim::Simulator>> simulators;
   std::vector<messages::RingRequest> requests;
   for (int r = 0; r < renderers; ++r) {
-    simulators.push_back(std::make_unique<sim::Simulator>(Config(options, true, v.scale, v.msaa, v.shadows)));
+    simulators.push_back(std::make_unique<sim::Simulator>(Config(options, true, v.scale, v.msaa, v.shadows, v.culling)));
     messages::RingRequest request = RequestFor(*simulators.back(), v);
     if (v.two_threads) {  // each renderer takes every other camera
       std::vector<int> mine;
@@ -115,16 +118,23 @@ nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
                         {"cameras", cameras},
                         {"msaa_samples", v.msaa},
                         {"shadows", v.shadows},
+                        {"frustum_culling", v.culling},
                         {"renderers", renderers},
                         {"ms_per_ring", ring_ms},
                         {"ms_per_camera", ring_ms / static_cast<double>(cameras)}};
-  if (!v.two_threads) out["stages_ms_per_ring"] = StageMs(before, simulators[0]->timings(), options.frames);
+  if (!v.two_threads) {
+    const sim::SimulatorTimings after = simulators[0]->timings();
+    out["stages_ms_per_ring"] = StageMs(before, after, options.frames);
+    const long drawn = after.geoms_drawn - before.geoms_drawn, culled = after.geoms_culled - before.geoms_culled;
+    out["geoms_drawn_fraction"] = drawn + culled > 0 ? static_cast<double>(drawn) / static_cast<double>(drawn + culled) : 1.0;
+  }
   std::printf("  %-34s %2zu x %4dx%-4d  %7.1f ms/ring  %6.1f ms/camera", v.name.c_str(), cameras, out["width"].get<int>(),
               out["height"].get<int>(), ring_ms, ring_ms / static_cast<double>(cameras));
   if (!v.two_threads) {
     const auto& st = out["stages_ms_per_ring"];
-    std::printf("  (draw %.1f, readback %.1f, distortion %.1f, exposure+noise %.1f)", st["draw"].get<double>(),
-                st["readback"].get<double>(), st["distortion"].get<double>(), st["exposure_noise"].get<double>());
+    std::printf("  (draw %.1f, readback %.1f, distortion %.1f, exposure+noise %.1f; %.0f %% of the geoms drawn)",
+                st["draw"].get<double>(), st["readback"].get<double>(), st["distortion"].get<double>(),
+                st["exposure_noise"].get<double>(), 100.0 * out["geoms_drawn_fraction"].get<double>());
   }
   std::printf("\n");
   return out;
@@ -162,6 +172,7 @@ int RunBench(const BenchOptions& options) {
               options.frames, std::thread::hardware_concurrency());
   const std::vector<RenderVariant> variants = {
       {"full ring, msaa 4, shadows", 1.0, 4, true, false, false},
+      {"full ring, msaa 4, shadows, no culling", 1.0, 4, true, false, false, false},
       {"full ring, msaa 0, shadows", 1.0, 0, true, false, false},
       {"full ring, msaa 4, no shadows", 1.0, 4, false, false, false},
       {"full ring, msaa 0, no shadows", 1.0, 0, false, false, false},

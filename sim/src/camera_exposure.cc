@@ -5,7 +5,7 @@
 
 namespace trimbot::sim {
 
-ExposureResult ApplyAutoExposure(cv::Mat& rgb, const robot::AutoExposure& parameters) {
+ExposureResult MeterExposure(const cv::Mat& rgb, const robot::AutoExposure& parameters) {
   ExposureResult result;
   if (!parameters.enabled || rgb.empty()) return result;
   const int top = static_cast<int>(std::lround(parameters.metering_top * rgb.rows));
@@ -14,7 +14,6 @@ ExposureResult ApplyAutoExposure(cv::Mat& rgb, const robot::AutoExposure& parame
   const double wanted = parameters.target_mean / metered;
   result.exposure_factor = std::clamp(wanted, 1.0 / parameters.max_exposure_factor, parameters.max_exposure_factor);
   result.gain = std::clamp(wanted / result.exposure_factor, 1.0, parameters.max_gain);
-  rgb.convertTo(rgb, CV_8UC3, result.exposure_factor * result.gain);  // saturates
   return result;
 }
 

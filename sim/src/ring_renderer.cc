@@ -3,6 +3,9 @@
 #include <GL/osmesa.h>
 
 #include <opencv2/imgproc.hpp>
+#include <Eigen/Core>
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -25,10 +28,81 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+using Vec3 = Eigen::Vector3d;
+
+Vec3 ToVec(const float* v) { return Vec3(v[0], v[1], v[2]); }
+
+// A half-space bounding the view volume: a point x is outside where normal.dot(x) > offset.
+struct Plane {
+  Vec3 normal;
+  double offset;
+  double Distance(const Vec3& x) const { return normal.dot(x) - offset; }
+};
+
+// The six planes of the camera's view volume, as OpenGL will draw it for this viewport.
+std::array<Plane, 6> ViewVolume(const mjvGLCamera& camera, double aspect) {
+  const Vec3 eye = ToVec(camera.pos), forward = ToVec(camera.forward).normalized();
+  const Vec3 up = ToVec(camera.up).normalized(), right = forward.cross(up);
+  const double near = camera.frustum_near;
+  const double half_width = 0.5 * aspect * (camera.frustum_top - camera.frustum_bottom);
+  const double left = (camera.frustum_center - half_width) / near, rightmost = (camera.frustum_center + half_width) / near;
+  const double bottom = camera.frustum_bottom / near, top = camera.frustum_top / near;
+  auto side = [&](const Vec3& axis, double slope, double sign) {
+    // Points with sign * (axis . (x - eye) - slope * forward . (x - eye)) > 0 are outside.
+    const Vec3 normal = (sign * (axis - slope * forward)).normalized();
+    return Plane{normal, normal.dot(eye)};
+  };
+  return {side(right, rightmost, 1.0), side(right, left, -1.0), side(up, top, 1.0), side(up, bottom, -1.0),
+          Plane{-forward, -forward.dot(eye) - near}, Plane{forward, forward.dot(eye) + camera.frustum_far}};
+}
+
+// Keeps in the scene only the geoms that can show in this camera: those whose bounding sphere,
+// or the shadow it casts from a shadow-casting directional light down to the ground, meets the
+// view volume. What is dropped would be clipped by OpenGL anyway, so the image is the same; the
+// three passes of a shadowed scene (lit, shadow map, shadowed) then draw a fifth of the garden.
+// Returns how many were dropped.
+int KeepVisibleGeoms(mjvScene* scene, double aspect) {
+  const std::array<Plane, 6> volume = ViewVolume(scene->camera[0], aspect);
+  std::vector<Vec3> shadow_directions;
+  if (scene->flags[mjRND_SHADOW]) {
+    for (int i = 0; i < scene->nlight; ++i) {
+      const mjvLight& light = scene->lights[i];
+      if (light.castshadow && light.directional) shadow_directions.push_back(ToVec(light.dir).normalized());
+    }
+  }
+  const double longest_shadow = scene->camera[0].frustum_far;
+  auto capsule_outside = [&](const Vec3& a, const Vec3& b, double radius) {
+    for (const Plane& plane : volume) {
+      if (plane.Distance(a) > radius && plane.Distance(b) > radius) return true;
+    }
+    return false;
+  };
+  int kept = 0;
+  for (int i = 0; i < scene->ngeom; ++i) {
+    const mjvGeom& geom = scene->geoms[i];
+    const double radius = geom.modelrbound;
+    bool visible = radius <= 0.0;  // decor and unbounded geoms are always drawn
+    const Vec3 centre = ToVec(geom.pos);
+    if (!visible) visible = !capsule_outside(centre, centre, radius);
+    for (size_t l = 0; !visible && l < shadow_directions.size(); ++l) {
+      const Vec3& direction = shadow_directions[l];
+      // The shadow falls along the light until the ground (z = 0).
+      const double length = direction.z() < -1e-3 ? std::min((centre.z() + radius) / -direction.z(), longest_shadow)
+                                                   : longest_shadow;
+      visible = !capsule_outside(centre, centre + std::max(length, 0.0) * direction, radius);
+    }
+    if (visible) scene->geoms[kept++] = geom;
+  }
+  const int dropped = scene->ngeom - kept;
+  scene->ngeom = kept;
+  return dropped;
+}
+
 }  // namespace
 
-RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, double oversampling)
-    : world_(world), rig_(rig), oversampling_(oversampling), gl_(std::make_unique<GlState>()) {
+RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, bool frustum_culling, double oversampling)
+    : world_(world), rig_(rig), frustum_culling_(frustum_culling), oversampling_(oversampling),
+      gl_(std::make_unique<GlState>()) {
   const mjModel* m = world.model();
   const int width = m->vis.global.offwidth, height = m->vis.global.offheight;
   gl_->context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
@@ -85,7 +159,9 @@ const RingRenderer::CameraSetup& RingRenderer::Setup(int index, double resolutio
     for (int u = 0; u < setup.model.width; ++u) {
       const Eigen::Vector2d ray = setup.model.Undistort(Eigen::Vector2d(u, v));
       setup.map_x.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.x() + setup.render.cx);
-      setup.map_y.at<float>(v, u) = static_cast<float>(setup.render.focal * ray.y() + setup.render.cy);
+      // OpenGL rows start at the bottom: the map reads the render upside down, so no flip is needed.
+      const double row = setup.render.focal * ray.y() + setup.render.cy;
+      setup.map_y.at<float>(v, u) = static_cast<float>(setup.render.height - 1 - row);
     }
   }
   return setups_.emplace(key, std::move(setup)).first->second;
@@ -100,6 +176,13 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   view.type = mjCAMERA_FIXED;
   view.fixedcamid = camera_id;
   mjv_updateScene(m, world_.data(), &gl_->option, nullptr, &view, mjCAT_ALL, &gl_->scene);
+  const int culled = frustum_culling_
+                         ? KeepVisibleGeoms(&gl_->scene, static_cast<double>(camera.render.width) / camera.render.height)
+                         : 0;
+  if (!segmentation) {
+    timings_.geoms_in_view += gl_->scene.ngeom;
+    timings_.geoms_culled += culled;
+  }
   gl_->scene.flags[mjRND_SEGMENT] = segmentation ? 1 : 0;
   gl_->scene.flags[mjRND_IDCOLOR] = segmentation ? 1 : 0;
   const mjrRect viewport = {0, 0, camera.render.width, camera.render.height};
@@ -108,15 +191,13 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   if (!segmentation) timings_.draw += SecondsSince(start);
   start = Clock::now();
   mjr_readPixels(gl_->rgb.data(), depth ? gl_->depth.data() : nullptr, viewport, &gl_->render_context);
-  // OpenGL rows start at the bottom.
-  const cv::Mat rgb_up(camera.render.height, camera.render.width, CV_8UC3, gl_->rgb.data());
-  cv::flip(rgb_up, *rgb, 0);
+  // Rows stay in OpenGL's order (bottom first): the camera's maps turn them upright. The image
+  // shares the renderer's buffer, valid until the next pass.
+  *rgb = cv::Mat(camera.render.height, camera.render.width, CV_8UC3, gl_->rgb.data());
   if (!segmentation) timings_.readback += SecondsSince(start);
   if (depth != nullptr) {
     const auto depth_start = Clock::now();
-    const cv::Mat depth_up(camera.render.height, camera.render.width, CV_32F, gl_->depth.data());
-    cv::Mat buffer;
-    cv::flip(depth_up, buffer, 0);
+    const cv::Mat buffer(camera.render.height, camera.render.width, CV_32F, gl_->depth.data());
     // Non-linear depth buffer -> metres along the optical axis (standard OpenGL projection).
     const double znear = m->vis.map.znear * m->stat.extent;
     const double zfar = m->vis.map.zfar * m->stat.extent;
@@ -156,18 +237,24 @@ RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_
   cv::remap(depth, view.depth, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::Mat segmentation;
   RenderPass(camera, camera_id, true, &segmentation, nullptr);
-  // Segment colour = scene geom index + 1; map it to the model geom and its label.
+  // Segment colour = the geom's segmentation id + 1 (its index in the scene before culling); map it
+  // to the model geom and its label.
+  const mjvScene& scene = gl_->scene;
+  std::vector<const GeomLabel*> label_of_segment;
+  for (int i = 0; i < scene.ngeom; ++i) {
+    const mjvGeom& geom = scene.geoms[i];
+    if (geom.segid < 0 || geom.objtype != mjOBJ_GEOM) continue;
+    if (geom.segid >= static_cast<int>(label_of_segment.size())) label_of_segment.resize(geom.segid + 1, nullptr);
+    label_of_segment[geom.segid] = world_.label(geom.objid);
+  }
   cv::Mat object_class(segmentation.size(), CV_8U, cv::Scalar(0));
   cv::Mat object_id(segmentation.size(), CV_16U, cv::Scalar(0));
-  const mjvScene& scene = gl_->scene;
   for (int r = 0; r < segmentation.rows; ++r) {
     const cv::Vec3b* in = segmentation.ptr<cv::Vec3b>(r);
     for (int c = 0; c < segmentation.cols; ++c) {
       const int segment = in[c][0] + 256 * in[c][1] + 65536 * in[c][2] - 1;
-      if (segment < 0 || segment >= scene.ngeom) continue;
-      const mjvGeom& geom = scene.geoms[segment];
-      if (geom.objtype != mjOBJ_GEOM) continue;
-      const GeomLabel* label = world_.label(geom.objid);
+      if (segment < 0 || segment >= static_cast<int>(label_of_segment.size())) continue;
+      const GeomLabel* label = label_of_segment[segment];
       if (label == nullptr) continue;
       object_class.at<uchar>(r, c) = static_cast<uchar>(label->object_class);
       object_id.at<uint16_t>(r, c) = label->object_id;

@@ -115,7 +115,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   impl_->end_effector_body = mj_name2id(m, mjOBJ_BODY, RobotFrames::kEndEffector);
   impl_->fault_applied.assign(config.faults.size(), false);
   if (config.render_cameras) {
-    impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_);
+    impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.frustum_culling);
     impl_->read_noise = std::make_unique<ReadNoise>(StreamSeed(config.seed, "camera_read_noise"));
   }
 }
@@ -266,6 +266,8 @@ SimulatorTimings Simulator::timings() const {
     out.distortion = r.distortion;
     out.ground_truth = r.ground_truth;
     out.camera_images = r.images;
+    out.geoms_drawn = r.geoms_in_view;
+    out.geoms_culled = r.geoms_culled;
   }
   return out;
 }
@@ -296,11 +298,13 @@ RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool wi
   for (int i : request.cameras) {
     RenderedView view = impl_->renderer->Render(i, request.resolution_scale, with_ground_truth);
     const auto start = std::chrono::steady_clock::now();
-    // The sensor's exposure control, then its read noise (amplified by the gain), seeded per frame
-    // and camera so each image is reproducible on its own.
-    const ExposureResult exposure = ApplyAutoExposure(view.rgb, parameters_.cameras.auto_exposure);
-    impl_->read_noise->Apply(view.rgb, parameters_.cameras.noise_sigma * exposure.gain,
-                             StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i)));
+    // The sensor's exposure control, then the read-out: signal times exposure and gain, plus read
+    // noise (amplified by the gain) seeded per frame and camera so each image is reproducible alone.
+    const ExposureResult exposure = MeterExposure(view.rgb, parameters_.cameras.auto_exposure);
+    const std::uint64_t image_seed =
+        StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i));
+    impl_->read_noise->ReadOut(view.rgb, exposure.exposure_factor * exposure.gain,
+                               parameters_.cameras.noise_sigma * exposure.gain, image_seed);
     messages::Image image;
     image.stamp = capture.frame.stamp;
     image.camera_index = i;

@@ -1,5 +1,5 @@
 #pragma once
-// The cameras' automatic exposure (robot::AutoExposure) applied to a rendered image: the renderer
+// The cameras' automatic exposure (robot::AutoExposure) for a rendered image: the renderer
 // gives the scene at a fixed daylight exposure; a real sensor meters the ground and adjusts its
 // exposure time, then its gain. Plain function of the image: the same image, the same result.
 #include <opencv2/core.hpp>
@@ -13,7 +13,8 @@ struct ExposureResult {
   double gain = 1.0;             // analogue gain on top (amplifies read noise)
 };
 
-// Scales `rgb` (CV_8UC3) in place, saturating at 255; returns what the sensor chose.
-ExposureResult ApplyAutoExposure(cv::Mat& rgb, const robot::AutoExposure& parameters);
+// What the sensor chooses for this rendered image (CV_8UC3); the image is scaled by
+// exposure_factor * gain when it is read out (ReadNoise::ReadOut).
+ExposureResult MeterExposure(const cv::Mat& rgb, const robot::AutoExposure& parameters);
 
 }  // namespace trimbot::sim

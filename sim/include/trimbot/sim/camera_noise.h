@@ -14,9 +14,11 @@ namespace trimbot::sim {
 class ReadNoise {
  public:
   explicit ReadNoise(std::uint64_t seed, std::size_t bank_size = std::size_t{1} << 22);
-  // Adds Gaussian noise of `sigma` grey levels to `rgb` (CV_8UC3, saturating at 0 and 255), from
-  // the window `image_seed` picks: the same image seed, the same noise.
-  void Apply(cv::Mat& rgb, double sigma, std::uint64_t image_seed) const;
+  // Reads a rendered image out as the sensor does: the signal scaled by the exposure and gain
+  // (`signal_scale`), plus Gaussian noise of `sigma` grey levels from the window `image_seed` picks,
+  // rounded and clipped to 0..255 once, as the converter does (noise on a saturated pixel is
+  // clipped too). `rgb` is CV_8UC3, changed in place. The same image seed, the same noise.
+  void ReadOut(cv::Mat& rgb, double signal_scale, double sigma, std::uint64_t image_seed) const;
 
  private:
   std::vector<float> bank_;  // unit normal samples

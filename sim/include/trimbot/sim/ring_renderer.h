@@ -25,11 +25,14 @@ struct RenderTimings {
   double distortion = 0.0;  // resampling the pinhole render into the calibrated (distorted) camera
   double ground_truth = 0.0;  // depth to metres, the label pass and their remaps, when asked for
   long images = 0;          // camera images rendered
+  long geoms_in_view = 0;   // summed over colour images: geoms drawn,
+  long geoms_culled = 0;    // and geoms outside the view volume (and their shadows), not drawn
 };
 
 class RingRenderer {
  public:
-  RingRenderer(const World& world, const robot::CameraRig& rig, double oversampling = 1.0);
+  // frustum_culling: each camera draws only the geoms that can show in it (the same image, faster).
+  RingRenderer(const World& world, const robot::CameraRig& rig, bool frustum_culling = true, double oversampling = 1.0);
   ~RingRenderer();
   RingRenderer(const RingRenderer&) = delete;
   RingRenderer& operator=(const RingRenderer&) = delete;
@@ -43,7 +46,7 @@ class RingRenderer {
   struct CameraSetup {
     robot::PinholeRadtan model;
     RenderPinhole render;
-    cv::Mat map_x, map_y;  // output pixel -> render pixel
+    cv::Mat map_x, map_y;  // output pixel -> render pixel (rows as OpenGL reads them: bottom first)
   };
   // Built on the first request for a camera and resolution, then kept.
   const CameraSetup& Setup(int index, double resolution_scale);
@@ -51,6 +54,7 @@ class RingRenderer {
 
   const World& world_;
   const robot::CameraRig& rig_;
+  bool frustum_culling_;
   double oversampling_;
   std::map<std::pair<int, long>, CameraSetup> setups_;  // (camera, scale in 1/10000)
   RenderTimings timings_;

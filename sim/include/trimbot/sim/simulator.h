@@ -45,6 +45,7 @@ struct SimulatorConfig {
   int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
   double resolution_scale = 1.0;     // 0.5 renders half-resolution images
   int msaa_samples = 4;              // anti-aliasing; 0 halves the render time, edges get jagged
+  bool frustum_culling = true;       // each camera draws only the geoms that can show in it (same image)
   double imu_noise_scale = 1.0;      // multiplies every IMU noise parameter
   double wheel_slip_scale = 1.0;     // multiplies the surfaces' slip (mean and spread)
   std::vector<Fault> faults;         // injected at their times
@@ -106,6 +107,8 @@ struct SimulatorTimings {
   long physics_steps = 0;
   long ring_frames = 0;
   long camera_images = 0;
+  long geoms_drawn = 0;         // summed over camera images: geoms in each camera's view volume
+  long geoms_culled = 0;        // and those outside it, not drawn
 };
 
 struct RingCapture {
