@@ -2,6 +2,7 @@
 // obstacles, path following on a simulated unicycle, goal-to-goal navigation with the obstacle stop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -181,6 +182,84 @@ TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   }
   EXPECT_TRUE(stopped);
   EXPECT_TRUE(backed);
+}
+
+// Drives `navigator` on a perfect unicycle from `pose` until it is done or failed (or 300 s), and
+// returns its events; `on_step(t, pose)` runs before each update.
+template <typename OnStep>
+std::vector<NavigationEvent> DriveUntilDone(Navigator& navigator, Pose2& pose, OnStep on_step) {
+  std::vector<NavigationEvent> events;
+  for (double t = 0.0; t < 300.0; t += 0.05) {
+    const Navigator::Mode mode = navigator.mode();
+    if (mode == Navigator::Mode::kDone || mode == Navigator::Mode::kFailed) break;
+    on_step(t, pose);
+    pose = Integrate(pose, navigator.Update(t, pose), 0.05);
+    for (const auto& e : navigator.TakeEvents()) events.push_back(e);
+  }
+  return events;
+}
+
+int Count(const std::vector<NavigationEvent>& events, NavigationEvent::Type type) {
+  return static_cast<int>(std::count_if(events.begin(), events.end(), [type](const auto& e) { return e.type == type; }));
+}
+
+// An obstacle the prior map lacks appears on the path (perception's costmap): the navigator plans
+// again and goes around it, never closer than the footprint allows.
+TEST(Navigator, PlansAgainWhenASeenObstacleBlocksThePath) {
+  SeedPlanner(12);
+  const OccupancyGrid map = WallMap();
+  Navigator navigator(map, NavigatorParameters{});
+  navigator.SetGoals({{3.8, 7.0}});
+  Pose2 pose{3.8, 0.8, M_PI / 2};
+  const Eigen::Vector2d box(3.8, 4.0);  // 0.4 m square, on the straight line to the goal
+  cv::Mat occupied = map.occupied().clone();
+  for (double x = box.x() - 0.2; x <= box.x() + 0.2; x += 0.025) {
+    for (double y = box.y() - 0.2; y <= box.y() + 0.2; y += 0.025) occupied.at<uchar>(map.Cell({x, y})) = 255;
+  }
+  bool seen = false;
+  double closest = 1e9;
+  const auto events = DriveUntilDone(navigator, pose, [&](double, const Pose2& p) {
+    if (!seen && p.y > 1.5) {  // seen 2.5 m ahead, as stereo would
+      navigator.SetCostmap(OccupancyGrid(occupied, map.resolution(), map.origin()));
+      seen = true;
+    }
+    closest = std::min(closest, (Eigen::Vector2d(p.x, p.y) - box).cwiseAbs().maxCoeff() - 0.2);
+  });
+  EXPECT_EQ(navigator.mode(), Navigator::Mode::kDone);
+  EXPECT_EQ(Count(events, NavigationEvent::Type::kPathBlocked), 1);
+  EXPECT_EQ(Count(events, NavigationEvent::Type::kGoalReached), 1);
+  EXPECT_GT(closest, 0.4) << "base_link came within " << closest << " m of the box";
+  EXPECT_LT(std::hypot(pose.x - 3.8, pose.y - 7.0), 0.1);
+}
+
+// A goal 0.3 m from an obstacle (inside the planner's 0.5 m clearance) is not refused: it is
+// reached at the nearest point the robot can arrive at facing any way (the footprint's reach,
+// 0.71 m, plus its 0.1 m margin from the obstacle), and the event says where.
+TEST(Navigator, GoalNearAnObstacleIsReachedAtTheNearestFeasiblePoint) {
+  SeedPlanner(13);
+  const OccupancyGrid map = WallMap();
+  const NavigatorParameters parameters;
+  Navigator navigator(map, parameters);
+  const Eigen::Vector2d goal(4.5, 3.0);  // the wall starts at x = 4.8
+  navigator.SetGoals({goal});
+  Pose2 pose{1.5, 3.0, 0.0};
+  const auto events = DriveUntilDone(navigator, pose, [](double, const Pose2&) {});
+  ASSERT_EQ(navigator.mode(), Navigator::Mode::kDone);
+  const auto adjusted = std::find_if(events.begin(), events.end(),
+                                     [](const auto& e) { return e.type == NavigationEvent::Type::kGoalAdjusted; });
+  ASSERT_NE(adjusted, events.end());
+  EXPECT_NEAR(map.DistanceToObstacle(adjusted->position), 0.81, 0.05);
+  EXPECT_NEAR((adjusted->position - goal).norm(), 0.51, 0.05) << "straight back from the wall";
+  EXPECT_LT(std::hypot(pose.x - adjusted->position.x(), pose.y - adjusted->position.y()), 0.1);
+  // Within goal_search_radius no point is clear enough: the goal is refused as before.
+  NavigatorParameters strict = parameters;
+  strict.goal_search_radius = 0.3;
+  Navigator refusing(map, strict);
+  refusing.SetGoals({goal});
+  Pose2 start{1.5, 3.0, 0.0};
+  const auto refused = DriveUntilDone(refusing, start, [](double, const Pose2&) {});
+  EXPECT_EQ(refusing.mode(), Navigator::Mode::kFailed);
+  EXPECT_EQ(Count(refused, NavigationEvent::Type::kGoalAdjusted), 0);
 }
 
 }  // namespace

@@ -26,7 +26,12 @@ std::string Tum(double t, const stack::Pose2& pose) { return TumLine(t, stack::T
 TrialEvaluator::TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance,
                                double fix_history_seconds)
     : goal_tolerance_(goal_tolerance), fix_history_seconds_(fix_history_seconds), goal_planned_(goals.size(), false) {
-  for (const auto& goal : goals) goals_.push_back({goal.x(), goal.y()});
+  for (const auto& goal : goals) {
+    GoalResult result;
+    result.x = result.used_x = goal.x();
+    result.y = result.used_y = goal.y();
+    goals_.push_back(result);
+  }
 }
 
 TrialEvaluator::PlanarPose TrialEvaluator::Planar(double t, const Eigen::Isometry3d& pose) {
@@ -102,10 +107,17 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
       if (event.goal >= 0 && event.goal < static_cast<int>(goal_planned_.size())) goal_planned_[event.goal] = true;
     }
     if (event.type == Type::kRecovered) ++recoveries_;
-    if (event.type == Type::kGoalReached && event.goal >= 0 && event.goal < static_cast<int>(goals_.size())) {
+    const bool known_goal = event.goal >= 0 && event.goal < static_cast<int>(goals_.size());
+    if (event.type == Type::kGoalAdjusted && known_goal) {
+      GoalResult& goal = goals_[event.goal];
+      goal.used_x = event.position.x();
+      goal.used_y = event.position.y();
+      goal.adjusted_by_m = std::hypot(goal.used_x - goal.x, goal.used_y - goal.y);
+    }
+    if (event.type == Type::kGoalReached && known_goal) {
       GoalResult& goal = goals_[event.goal];
       goal.arrival_time = step.time;
-      goal.final_error_m = std::hypot(truth.x - goal.x, truth.y - goal.y);
+      goal.final_error_m = std::hypot(truth.x - goal.used_x, truth.y - goal.used_y);
       goal.reached = goal.final_error_m <= goal_tolerance_;
     }
   }

@@ -48,7 +48,10 @@ void to_json(nlohmann::json& j, const GoalResult& g) {
        {"y", g.y},
        {"reached", g.reached},
        {"arrival_time", g.arrival_time},
-       {"final_error_m", g.final_error_m}};
+       {"final_error_m", g.final_error_m},
+       {"adjusted_by_m", g.adjusted_by_m},
+       {"used_x", g.used_x},
+       {"used_y", g.used_y}};
 }
 
 void from_json(const nlohmann::json& j, GoalResult& g) {
@@ -57,6 +60,9 @@ void from_json(const nlohmann::json& j, GoalResult& g) {
   j.at("reached").get_to(g.reached);
   j.at("arrival_time").get_to(g.arrival_time);
   j.at("final_error_m").get_to(g.final_error_m);
+  g.adjusted_by_m = j.value("adjusted_by_m", 0.0);  // results written before goals could move
+  g.used_x = j.value("used_x", g.x);
+  g.used_y = j.value("used_y", g.y);
 }
 
 void to_json(nlohmann::json& j, const TrialResult& t) {

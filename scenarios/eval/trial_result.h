@@ -31,6 +31,10 @@ struct GoalResult {
   bool reached = false;           // the robot declared arrival and was within tolerance (ground truth)
   double arrival_time = -1.0;     // s of simulated time since the trial's start, -1 if never
   double final_error_m = -1.0;    // ground-truth distance to the goal when the robot declared arrival
+  // A goal inside an obstacle's clearance is moved by the robot to the nearest point it can arrive
+  // at (within its goal_search_radius): arrival is judged there, and the move is reported.
+  double adjusted_by_m = 0.0;     // 0: the goal as asked
+  double used_x = 0.0, used_y = 0.0;  // the goal navigated to (as asked, or adjusted)
 };
 
 struct TrialResult {

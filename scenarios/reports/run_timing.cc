@@ -39,6 +39,7 @@ RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim
         {"visual_pose", "stack", v.pose, frames, "localized frame"},
         {"visual_other", "stack", visual_rest, frames, "localized frame"},
         {"stereo_fusion", "stack", stack->perception, 0, ""},
+        {"obstacles", "stack", stack->obstacles, stack->obstacle_pairs, "stereo pair"},
         {"planning", "stack", stack->planning, 0, ""},
         {"control", "stack", stack->control, 0, ""}};
     t.stages.insert(t.stages.end(), stack_stages.begin(), stack_stages.end());

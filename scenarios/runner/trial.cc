@@ -61,8 +61,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
   const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
-  const bool stack_uses_images = visual || parameters.local_fusion.enabled;
-  sim::Simulator simulator(PlantFor(setup, stack_uses_images));
+  sim::Simulator simulator(PlantFor(setup, parameters.UsesRingImages()));
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
   robot.SetMap(setup.map_yaml);
@@ -79,7 +78,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   LoopOptions options;
   options.time_limit = scenario.time_limit;
   options.pose_fixes = fixes ? &*fixes : nullptr;
-  options.render_on_demand = stack_uses_images;
+  options.render_on_demand = parameters.UsesRingImages();
   options.progress = progress;
   const auto loop_start = std::chrono::steady_clock::now();
   const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);

@@ -95,18 +95,30 @@ bool GlobalPlanner::Free(const Eigen::Vector2d& point) const {
 }
 
 Eigen::Vector2d GlobalPlanner::NearestFree(const Eigen::Vector2d& point, double radius) const {
-  if (Free(point)) return point;
-  // Rings of growing radius, 32 directions each: the first free point found is the nearest (to
-  // within the ring spacing).
+  return NearestWithClearance(point, parameters_.robot_radius, radius).value_or(point);
+}
+
+double GlobalPlanner::ArrivalClearance() const {
+  const Footprint& f = parameters_.footprint;
+  double reach = 0.0;
+  for (double x : f.circle_x) reach = std::max(reach, std::abs(x) + f.circle_radius);
+  return std::max(parameters_.robot_radius, reach + parameters_.footprint_margin);
+}
+
+std::optional<Eigen::Vector2d> GlobalPlanner::NearestWithClearance(const Eigen::Vector2d& point, double clearance,
+                                                                   double radius) const {
+  if (map_.DistanceToObstacle(point) >= clearance) return point;
+  // Rings of growing radius, 32 directions each: the first point found is the nearest (to within
+  // the ring spacing).
   const double step = map_.resolution();
-  for (double r = step; r <= radius; r += step) {
+  for (double r = step; r <= radius + 1e-9; r += step) {
     for (int k = 0; k < 32; ++k) {
       const double a = 2.0 * M_PI * k / 32.0;
       const Eigen::Vector2d candidate = point + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-      if (Free(candidate)) return candidate;
+      if (map_.DistanceToObstacle(candidate) >= clearance) return candidate;
     }
   }
-  return point;
+  return std::nullopt;
 }
 
 PlanResult GlobalPlanner::Plan(const Eigen::Vector2d& start, const Eigen::Vector2d& goal, int attempt) const {

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <utility>
 
 namespace trimbot::stack {
 
@@ -15,12 +17,45 @@ const char* ToString(NavigationEvent::Type type) {
     case NavigationEvent::Type::kGoalFailed: return "goal_failed";
     case NavigationEvent::Type::kObstacleStop: return "obstacle_stop";
     case NavigationEvent::Type::kRecovered: return "recovered";
+    case NavigationEvent::Type::kPathBlocked: return "path_blocked";
+    case NavigationEvent::Type::kGoalAdjusted: return "goal_adjusted";
   }
   return "?";
 }
 
 Navigator::Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters)
-    : map_(map), parameters_(parameters), planner_(map, parameters.planner), follower_(parameters.follower) {}
+    : map_(map), costmap_(map), parameters_(parameters), planner_(costmap_, parameters.planner),
+      follower_(parameters.follower) {}
+
+void Navigator::SetCostmap(OccupancyGrid costmap) {
+  if (costmap.occupied().size() != map_.occupied().size() || costmap.resolution() != map_.resolution() ||
+      costmap.origin() != map_.origin()) {
+    throw std::invalid_argument("Navigator::SetCostmap: the costmap must have the prior map's cells");
+  }
+  costmap_ = std::move(costmap);  // the planner refers to costmap_ itself
+  costmap_changed_ = true;
+}
+
+bool Navigator::PathAheadBlocked(const Pose2& estimate) const {
+  const std::vector<Eigen::Vector2d>& path = follower_.path();
+  const Eigen::Vector2d robot(estimate.x, estimate.y);
+  const double step = 0.5 * costmap_.resolution();
+  double along = 0.0;
+  for (std::size_t i = follower_.segment() + 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1], b = path[i];
+    const double length = (b - a).norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2d q = a + (static_cast<double>(k) / steps) * (b - a);
+      // Right around the robot the obstacle stop guards it; the path starts where it stood.
+      if ((q - robot).norm() < parameters_.planner.start_footprint_free) continue;
+      if (costmap_.DistanceToObstacle(q) < parameters_.blocked_clearance) return true;
+    }
+    along += length;
+    if (along > parameters_.blocked_horizon) break;
+  }
+  return false;
+}
 
 void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
   goals_ = goals;
@@ -32,11 +67,12 @@ void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
 }
 
 double Navigator::FootprintClearance(const Pose2& pose) const {
-  return parameters_.planner.footprint.Clearance(map_, pose.x, pose.y, pose.yaw);
+  return parameters_.planner.footprint.Clearance(costmap_, pose.x, pose.y, pose.yaw);
 }
 
-void Navigator::Emit(double stamp, NavigationEvent::Type type, const std::string& detail) {
-  events_.push_back({stamp, type, goal_, detail});
+void Navigator::Emit(double stamp, NavigationEvent::Type type, const std::string& detail,
+                     const Eigen::Vector2d& position) {
+  events_.push_back({stamp, type, goal_, detail, position});
 }
 
 std::vector<NavigationEvent> Navigator::TakeEvents() {
@@ -53,7 +89,18 @@ void Navigator::GiveUpGoal(double stamp, const std::string& why) {
 
 void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   const auto start = std::chrono::steady_clock::now();
-  const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goals_[goal_], plan_failures_);
+  Eigen::Vector2d goal = goals_[goal_];
+  if (!planner_.Free(goal)) {
+    // Inside an obstacle's clearance (of the map, or seen): the nearest point the robot can arrive
+    // at from any direction instead (its footprint may face the obstacle there).
+    const auto nearest =
+        planner_.NearestWithClearance(goal, planner_.ArrivalClearance(), parameters_.goal_search_radius);
+    if (nearest) {
+      Emit(stamp, NavigationEvent::Type::kGoalAdjusted, std::to_string((*nearest - goal).norm()) + " m", *nearest);
+      goal = *nearest;
+    }
+  }
+  const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goal, plan_failures_);
   planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
     Emit(stamp, NavigationEvent::Type::kPlanFailed, plan.message);
@@ -108,6 +155,14 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
     backoff_start_ = {estimate.x, estimate.y};
     mode_ = Mode::kBackingOff;
     return stop;
+  }
+  if (costmap_changed_) {
+    costmap_changed_ = false;
+    if (PathAheadBlocked(estimate)) {
+      Emit(stamp, NavigationEvent::Type::kPathBlocked);
+      mode_ = Mode::kIdle;
+      return stop;
+    }
   }
   if (follow.deviation > parameters_.replan_deviation) {
     mode_ = Mode::kIdle;

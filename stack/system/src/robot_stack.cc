@@ -14,7 +14,10 @@
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/navigator.h"
+#include "trimbot/stack/obstacle_layer.h"
 #include "trimbot/stack/occupancy_grid.h"
+#include "trimbot/perception/obstacle_points.h"
+#include "trimbot/perception/stereo.h"
 #include "trimbot/stack/wheel_odometry.h"
 #include "trimbot/common/random.h"
 #include "trimbot/visual_localization/localizer.h"
@@ -68,6 +71,8 @@ struct RobotStack::Components {
   std::unique_ptr<OccupancyGrid> map;
   std::unique_ptr<Navigator> navigator;
   std::unique_ptr<perception::LocalFusion> fusion;
+  std::unique_ptr<perception::RingStereo> obstacle_stereo;  // with obstacle detection on
+  std::unique_ptr<ObstacleLayer> obstacle_layer;            // made with the map
   std::unique_ptr<visual_localization::VisualLocalizer> localizer;
   Rng latency_rng;
 
@@ -80,6 +85,11 @@ struct RobotStack::Components {
         ekf(parameters.ekf, description.drive(), ticks_per_revolution),
         latency_rng(0) {
     if (parameters.local_fusion.enabled) fusion = std::make_unique<perception::LocalFusion>(rig, parameters.local_fusion);
+    if (parameters.obstacles.enabled) {
+      perception::StereoOptions stereo;
+      stereo.stride = parameters.obstacles.stride;
+      obstacle_stereo = std::make_unique<perception::RingStereo>(rig, stereo);
+    }
   }
 };
 
@@ -122,6 +132,9 @@ void RobotStack::SetMap(const std::string& map_yaml) {
   components_->navigator.reset();
   components_->map = std::make_unique<OccupancyGrid>(OccupancyGrid::LoadMapServer(map_yaml));
   components_->navigator = std::make_unique<Navigator>(*components_->map, parameters_.navigation);
+  if (components_->obstacle_stereo) {
+    components_->obstacle_layer = std::make_unique<ObstacleLayer>(*components_->map, parameters_.obstacles.layer);
+  }
 }
 
 void RobotStack::SetVisualMap(const std::string& map_path) {
@@ -157,6 +170,7 @@ void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
 void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
   if (VisualLocalizationDue(frame.stamp)) LocalizeVisually(frame);
+  if (ObstacleDetectionDue(frame.stamp)) DetectObstacles(frame);
   if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
     ScopedTimer timer(&telemetry_.timings.perception);
     // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
@@ -184,6 +198,18 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     request.cameras = components_->localizer->cameras();
     request.resolution_scale = parameters_.visual.image_scale;
   }
+  if (ObstacleDetectionDue(stamp)) {
+    messages::RingRequest ahead;
+    for (int pair : PairsAhead()) {
+      const robot::StereoPair& cameras =
+          components_->obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)].pair();
+      ahead.cameras.push_back(std::min(cameras.left, cameras.right));
+      ahead.cameras.push_back(std::max(cameras.left, cameras.right));
+    }
+    std::sort(ahead.cameras.begin(), ahead.cameras.end());
+    ahead.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
+    request = messages::Merge(request, ahead);
+  }
   if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
     messages::RingRequest stereo;
     for (int i = 0; i < components_->rig.size(); ++i) stereo.cameras.push_back(i);
@@ -191,6 +217,72 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     request = messages::Merge(request, stereo);
   }
   return request;
+}
+
+bool RobotStack::ObstacleDetectionDue(double stamp) const {
+  return components_->obstacle_stereo && components_->obstacle_layer && stamp + 1e-9 >= next_obstacle_frame_;
+}
+
+std::vector<int> RobotStack::PairsAhead() const {
+  // Backing off looks backwards; driving, turning or standing looks forwards.
+  const double travel = last_linear_command_ < 0.0 ? M_PI : 0.0;
+  std::vector<int> pairs;
+  const auto& rectifiers = components_->obstacle_stereo->rectifiers();
+  for (std::size_t i = 0; i < rectifiers.size(); ++i) {
+    const Eigen::Vector3d axis = rectifiers[i].T_base_rectified_left().linear().col(2);
+    const double bearing = std::atan2(axis.y(), axis.x());
+    if (std::abs(std::remainder(bearing - travel, 2.0 * M_PI)) <= parameters_.obstacles.max_bearing) {
+      pairs.push_back(static_cast<int>(i));
+    }
+  }
+  return pairs;
+}
+
+void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
+  ScopedTimer timer(&telemetry_.timings.obstacles);
+  Components& c = *components_;
+  next_obstacle_frame_ = frame.stamp + 1.0 / parameters_.obstacles.rate_hz;
+  const auto has = [&](int camera) {
+    return std::any_of(frame.images.begin(), frame.images.end(),
+                       [camera](const messages::Image& image) { return image.camera_index == camera; });
+  };
+  const Eigen::Isometry3d T_map_base = ToIsometry(c.ekf.Estimate().pose);
+  const double min_height = parameters_.obstacles.points.min_height;
+  perception::ObstaclePointOptions options = parameters_.obstacles.points;
+  // The robot's own body (base, ring, arm at rest) is the footprint's box with a margin.
+  const Footprint& footprint = parameters_.navigation.planner.footprint;
+  const auto [lowest, highest] = std::minmax_element(footprint.circle_x.begin(), footprint.circle_x.end());
+  const double margin = 0.05;
+  options.robot_min = {*lowest - footprint.circle_radius - margin, -footprint.circle_radius - margin};
+  options.robot_max = {*highest + footprint.circle_radius + margin, footprint.circle_radius + margin};
+  bool integrated = false;
+  for (int pair : PairsAhead()) {
+    const perception::StereoRectifier& rectifier = c.obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)];
+    if (!has(rectifier.pair().left) || !has(rectifier.pair().right)) continue;  // not delivered
+    const perception::RingStereo::PairResult result = c.obstacle_stereo->ComputePair(frame, pair);
+    const perception::ObstaclePoints points =
+        perception::FindObstaclePoints(result.cloud, rectifier.T_base_rectified_left().translation(), options);
+    ObstacleObservation observation;
+    observation.stamp = frame.stamp;
+    const Eigen::Vector3d sensor = T_map_base * points.sensor;
+    observation.sensor = sensor.head<2>();
+    observation.sensor_height = points.ground.Distance(points.sensor);
+    observation.min_obstacle_height = min_height;
+    observation.obstacles.reserve(points.obstacles.size());
+    for (const Eigen::Vector3d& p : points.obstacles) observation.obstacles.push_back((T_map_base * p).head<2>());
+    observation.ground.reserve(points.ground_points.size());
+    for (const Eigen::Vector3d& p : points.ground_points) observation.ground.push_back((T_map_base * p).head<2>());
+    c.obstacle_layer->Integrate(observation);
+    ++telemetry_.timings.obstacle_pairs;
+    ++telemetry_.obstacles.frames;
+    integrated = true;
+  }
+  if (!integrated) return;
+  telemetry_.obstacles.occupied_cells = c.obstacle_layer->OccupiedCells();
+  if (c.navigator) {
+    c.navigator->SetCostmap(c.obstacle_layer->MergedWith(*c.map));
+    ++telemetry_.obstacles.costmap_updates;
+  }
 }
 
 void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
@@ -272,6 +364,7 @@ messages::RobotCommands RobotStack::Update(double stamp) {
 void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) {
   if (teleop_) {
     commands->base = *teleop_;
+    last_linear_command_ = teleop_->linear;
     return;
   }
   Navigator* navigator = components_->navigator.get();
@@ -285,6 +378,7 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
     return;
   }
   commands->base = navigator->Update(stamp, components_->ekf.Estimate().pose);
+  last_linear_command_ = commands->base ? commands->base->linear : 0.0;
   telemetry_.events = navigator->TakeEvents();
   telemetry_.mission = ToMission(navigator->mode());
   telemetry_.current_goal = navigator->current_goal();

@@ -138,10 +138,38 @@ void ReadNavigation(Reader& r, StackParameters& s) {
   r.Number("replan_deviation", &p.replan_deviation, 0.01, 100.0, "m");
   r.Integer("max_recoveries_per_goal", &p.max_recoveries_per_goal, 0, 1000);
   r.Integer("max_plan_failures", &p.max_plan_failures, 1, 1000);
+  r.Number("goal_search_radius", &p.goal_search_radius, 0.0, 10.0, "m");
+  r.Number("blocked_clearance", &p.blocked_clearance, 0.0, 5.0, "m");
+  r.Number("blocked_horizon", &p.blocked_horizon, 0.0, 100.0, "m");
   if (p.resume_clearance < p.stop_clearance) r.map().Fail("resume_clearance", "must be at least stop_clearance");
   if (p.follower.min_speed > p.follower.cruise_speed) {
     r.map().Fail("follower", "min_speed must not exceed cruise_speed");
   }
+}
+
+void ReadObstacles(Reader& r, ObstacleDetectionParameters& p) {
+  r.Flag("enabled", &p.enabled);
+  r.Number("rate_hz", &p.rate_hz, 0.01, 100.0, "Hz");
+  r.Degrees("max_bearing_deg", &p.max_bearing, 0.0, 180.0);
+  r.Integer("stride", &p.stride, 1, 64);
+  perception::ObstaclePointOptions& points = p.points;
+  r.Number("min_height", &points.min_height, 0.0, 5.0, "m");
+  r.Number("max_height", &points.max_height, 0.0, 10.0, "m");
+  r.Number("ground_tolerance", &points.ground_tolerance, 0.0, 1.0, "m");
+  r.Number("max_position_sigma", &points.max_position_sigma, 1e-4, 10.0, "m");
+  r.Section("layer", [&](Reader& f) {
+    ObstacleLayerParameters& l = p.layer;
+    f.Number("size", &l.size, 1.0, 200.0, "m");
+    f.Number("hit", &l.hit, 1e-3, 10.0);
+    f.Number("miss", &l.miss, -10.0, -1e-3);
+    f.Number("occupied", &l.occupied, 0.0, 10.0);
+    f.Number("limit", &l.limit, 0.0, 100.0);
+    f.Number("decay_time", &l.decay_time, 0.1, 1e6, "s");
+    f.Integer("min_points", &l.min_points, 1, 65535);
+    if (l.limit <= l.occupied) f.map().Fail("limit", "must exceed occupied");
+  });
+  if (points.max_height <= points.min_height) r.map().Fail("max_height", "must exceed min_height");
+  if (points.ground_tolerance > points.min_height) r.map().Fail("ground_tolerance", "must not exceed min_height");
 }
 
 void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
@@ -174,6 +202,7 @@ void Read(Reader& r, StackParameters& s) {
       f.Integer("stride", &p.stride, 1, 64);
       f.Number("ground_keep", &p.ground_keep, 0.0, 1.0);
     });
+    perception.Section("obstacles", [&](Reader& f) { ReadObstacles(f, s.obstacles); });
   });
 }
 

@@ -7,6 +7,7 @@
 // once per process) the same problem gives the same path on any machine.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,13 @@ class GlobalPlanner {
   bool Free(const Eigen::Vector2d& point) const;
   // The free point nearest to `point` within `radius`, or `point` itself if none is free.
   Eigen::Vector2d NearestFree(const Eigen::Vector2d& point, double radius) const;
+  // Clearance at which the robot can arrive from any direction: the footprint's reach from
+  // base_link plus footprint_margin (the footprint may face the obstacle on arrival).
+  double ArrivalClearance() const;
+  // The point nearest to `point` within `radius` that keeps `clearance` from every obstacle, or
+  // nullopt if there is none.
+  std::optional<Eigen::Vector2d> NearestWithClearance(const Eigen::Vector2d& point, double clearance,
+                                                      double radius) const;
 
   const OccupancyGrid& map() const { return map_; }
   const PlannerParameters& parameters() const { return parameters_; }

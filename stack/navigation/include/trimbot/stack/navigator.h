@@ -1,7 +1,9 @@
 #pragma once
-// Goal-to-goal navigation on the pose estimate: plan over the prior map, follow the path, and when
-// the robot (by its estimate) gets too close to an obstacle of the map, stop, back off and plan
-// again - the recovery behaviour of the real robot's navigation. A system with explicit input
+// Goal-to-goal navigation on the pose estimate: plan over the costmap (the prior map plus the
+// obstacles perception has seen, SetCostmap), follow the path, plan again when what is seen
+// blocks it, and when the robot (by its estimate) gets too close to an obstacle, stop, back off
+// and plan again - the recovery behaviour of the real robot's navigation. A goal inside an
+// obstacle's clearance is moved to the nearest free point within goal_search_radius (reported). A system with explicit input
 // (time, pose estimate), output (base velocity command) and state (goal, path, mode); the events it
 // reports (goal reached, replans, recoveries, failures) go to the evaluation.
 #include <Eigen/Core>
@@ -26,14 +28,23 @@ struct NavigatorParameters {
   double replan_deviation = 0.6;     // m off the path -> plan again
   int max_recoveries_per_goal = 5;
   int max_plan_failures = 3;         // per goal, then the goal is given up
+  double goal_search_radius = 0.6;   // m: a goal in an obstacle's clearance moves at most this far
+  double blocked_clearance = 0.35;   // m: base_link's clearance along the path ahead below which
+                                     // the path counts as blocked (the planner keeps robot_radius)
+  double blocked_horizon = 4.0;      // m of path ahead checked when the costmap changes
 };
 
 struct NavigationEvent {
-  enum class Type { kPlanned, kPlanFailed, kGoalReached, kGoalFailed, kObstacleStop, kRecovered };
+  enum class Type {
+    kPlanned, kPlanFailed, kGoalReached, kGoalFailed, kObstacleStop, kRecovered,
+    kPathBlocked,   // an obstacle seen on the path ahead: plan again
+    kGoalAdjusted,  // the goal was in an obstacle's clearance: `position` is the goal used instead
+  };
   double stamp = 0.0;
   Type type = Type::kPlanned;
   int goal = 0;
   std::string detail;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // kGoalAdjusted: the goal used
 };
 const char* ToString(NavigationEvent::Type type);
 
@@ -44,14 +55,18 @@ class Navigator {
   Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters);
 
   void SetGoals(const std::vector<Eigen::Vector2d>& goals);
+  // The prior map with what perception has seen added (same size, resolution and origin as the
+  // prior map; std::invalid_argument otherwise). The path ahead is checked against it.
+  void SetCostmap(OccupancyGrid costmap);
   messages::BaseVelocityCommand Update(double stamp, const Pose2& estimate);
 
-  // Smallest distance from the footprint at `pose` to an obstacle of the map (negative: overlap).
+  // Smallest distance from the footprint at `pose` to an obstacle of the costmap (negative: overlap).
   double FootprintClearance(const Pose2& pose) const;
 
   Mode mode() const { return mode_; }
   int current_goal() const { return goal_; }
   const std::vector<Eigen::Vector2d>& path() const { return follower_.path(); }
+  const OccupancyGrid& costmap() const { return costmap_; }
   // Events since the last call.
   std::vector<NavigationEvent> TakeEvents();
   // Wall-clock seconds spent in the global planner since construction.
@@ -60,9 +75,13 @@ class Navigator {
  private:
   void PlanToCurrentGoal(double stamp, const Pose2& estimate);
   void GiveUpGoal(double stamp, const std::string& why);
-  void Emit(double stamp, NavigationEvent::Type type, const std::string& detail = {});
+  void Emit(double stamp, NavigationEvent::Type type, const std::string& detail = {},
+            const Eigen::Vector2d& position = Eigen::Vector2d::Zero());
+  // base_link would come closer than blocked_clearance to an obstacle on the path ahead.
+  bool PathAheadBlocked(const Pose2& estimate) const;
 
   const OccupancyGrid& map_;
+  OccupancyGrid costmap_;  // the planner plans on this
   NavigatorParameters parameters_;
   GlobalPlanner planner_;
   PathFollower follower_;
@@ -74,6 +93,7 @@ class Navigator {
   Eigen::Vector2d backoff_start_ = Eigen::Vector2d::Zero();
   std::vector<NavigationEvent> events_;
   double planning_seconds_ = 0.0;
+  bool costmap_changed_ = false;
 };
 
 }  // namespace trimbot::stack

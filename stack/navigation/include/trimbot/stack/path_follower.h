@@ -40,6 +40,7 @@ class PathFollower {
   void SetPath(const std::vector<Eigen::Vector2d>& path);
   FollowerOutput Update(const Pose2& pose);
   const std::vector<Eigen::Vector2d>& path() const { return path_; }
+  std::size_t segment() const { return segment_; }  // being driven: path()[segment] to path()[segment + 1]
   const FollowerParameters& parameters() const { return parameters_; }
 
  private:

@@ -33,6 +33,8 @@ struct StackTimings {
   double ekf = 0.0;                  // IMU, wheel ticks and fixes into the EKF, wheel odometry
   double visual_localization = 0.0;  // whole frames (split by stage in visual_frames)
   double perception = 0.0;           // stereo clouds and their registration (local fusion)
+  double obstacles = 0.0;            // stereo on the pairs ahead, obstacle points, layer, costmap
+  long obstacle_pairs = 0;           // stereo pairs those went through
   double planning = 0.0;             // global plans (RRT*)
   double control = 0.0;              // navigator and path follower, planning excluded
   // Visual localization: each localized frame's time by stage (features, retrieval, matching, pose).
@@ -45,6 +47,13 @@ struct VisualLocalizationCounters {
   int fixes = 0;          // of which gave a pose
   int failures = 0;       // no pose (too few features, matches or inliers)
   int stopped_updates = 0;  // control updates the robot stood still for lack of localization
+};
+
+// Obstacle detection from stereo, counted.
+struct ObstacleCounters {
+  int frames = 0;           // pair frames turned into obstacle observations
+  int occupied_cells = 0;   // cells of the obstacle layer believed occupied now
+  int costmap_updates = 0;  // times the navigator got a new costmap
 };
 
 // What the stack reports after an update, for logs and evaluation.
@@ -61,6 +70,7 @@ struct Telemetry {
   std::optional<perception::CloudRegistration> registration;  // local fusion, in the last update
   std::vector<messages::PoseFix> visual_fixes;  // the stack's own fixes applied in the last update
   VisualLocalizationCounters visual;
+  ObstacleCounters obstacles;
   StackTimings timings;
 };
 
@@ -120,6 +130,11 @@ class RobotStack {
   void LocalizeVisually(const messages::RingFrame& frame);
   void DeliverVisualFixes(double stamp);
   bool LocalizationLost() const;
+  // Obstacle detection is configured, has a map, and its rate allows a frame at `stamp`.
+  bool ObstacleDetectionDue(double stamp) const;
+  // The stereo pairs (indices into the rig's pairs) facing the direction of travel.
+  std::vector<int> PairsAhead() const;
+  void DetectObstacles(const messages::RingFrame& frame);
 
   StackParameters parameters_;
   struct Components;
@@ -135,6 +150,8 @@ class RobotStack {
   std::vector<PendingFix> pending_fixes_;   // visual fixes still "being computed"
   double localizer_busy_until_ = -1.0;
   double next_localization_ = 0.0;
+  double next_obstacle_frame_ = 0.0;
+  double last_linear_command_ = 0.0;  // m/s: its sign is the direction of travel
 };
 
 }  // namespace trimbot::stack

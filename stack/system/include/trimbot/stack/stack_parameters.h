@@ -7,8 +7,10 @@
 
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/perception/local_fusion.h"
+#include "trimbot/perception/obstacle_points.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
+#include "trimbot/stack/obstacle_layer.h"
 #include "trimbot/visual_localization/features.h"
 
 namespace trimbot::stack {
@@ -37,6 +39,18 @@ struct VisualLocalizationParameters {
 };
 const char* ToString(LocalizationSource source);
 
+// Obstacles from stereo: the pairs facing the direction of travel, at rate_hz, into the obstacle
+// layer merged with the prior map for navigation.
+struct ObstacleDetectionParameters {
+  bool enabled = false;
+  double rate_hz = 2.5;            // pair frames per second
+  double max_bearing = 0.7;        // rad: pairs whose optical axis is this close to the direction
+                                   // of travel (forward, or backward while backing off)
+  int stride = 2;                  // pixel stride of the stereo clouds
+  perception::ObstaclePointOptions points;  // the robot's own box comes from the footprint
+  ObstacleLayerParameters layer;
+};
+
 struct StackParameters {
   LocalizationSource localization = LocalizationSource::kNone;
   double initial_position_sigma = 0.2;  // m per axis
@@ -45,7 +59,13 @@ struct StackParameters {
   double control_rate_hz = 20.0;
   NavigatorParameters navigation;
   perception::LocalFusionOptions local_fusion;
+  ObstacleDetectionParameters obstacles;
   VisualLocalizationParameters visual;
+
+  // Some component uses the ring's images (the driver must deliver what RingRequestAt asks for).
+  bool UsesRingImages() const {
+    return localization == LocalizationSource::kVisual || local_fusion.enabled || obstacles.enabled;
+  }
 
   // Reads a complete parameter file. Throws InputError naming the file, line and key.
   static StackParameters Load(const std::string& path);
