@@ -292,7 +292,11 @@ TEST(TrajectoryPlot, DrawsMapTrajectoriesAndGoals) {
   failed.estimate = Line({0.0, -0.45}, {4.8, -0.3}, 30);
   const std::string path = testing::TempDir("batch_report") + "/trajectories.png";
   fs::remove(path);
-  WriteTrajectoryPlot(path, map, {good, failed}, {{6.0, 2.0}, {7.0, 0.5}}, "lawn: 2 trials, seed 7");
+  // The world has one more obstacle than the map: x in [0, 0.5], y in [2.5, 3.0].
+  garden::OccupancyMap world = map;
+  world.occupied = map.occupied.clone();
+  world.occupied(cv::Rect(40, 20, 10, 10)).setTo(255);
+  WriteTrajectoryPlot(path, map, world, {good, failed}, {{6.0, 2.0}, {7.0, 0.5}}, "lawn: 2 trials, seed 7");
   std::cout << "trajectory plot: " << path << "\n";
 
   const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);  // BGR
@@ -322,6 +326,10 @@ TEST(TrajectoryPlot, DrawsMapTrajectoriesAndGoals) {
   const cv::Vec3b obstacle = image.at<cv::Vec3b>(pixel(3.5, 3.0));
   EXPECT_LT(obstacle[1], 130);
   EXPECT_FALSE(Saturated(obstacle, 20));
+  // The obstacle the map lacks: orange.
+  const cv::Vec3b unmapped = image.at<cv::Vec3b>(pixel(0.25, 2.75));
+  EXPECT_GT(unmapped[2], 180);
+  EXPECT_LT(unmapped[0], 110);
   // Goal 2 is a white circle with a dark outline and number.
   EXPECT_TRUE(AnyNear(image, pixel(7.0, 0.5), 6, [](const cv::Vec3b& bgr) { return bgr[1] < 100; }));
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "sim_test_support.h"
 #include "trimbot/perception/obstacle_points.h"
@@ -28,12 +30,14 @@ int OccupiedIn(const ObstacleLayer& layer, const Eigen::Vector2d& low, const Eig
 ObstacleObservation SeeBox(double stamp, bool box_there) {
   ObstacleObservation o;
   o.stamp = stamp;
-  o.sensor_height = 0.5;
   o.min_obstacle_height = 0.1;
+  ObstacleView view;
+  view.sensor_height = 0.5;
   for (double y = -0.2; y <= 0.2; y += 0.02) {
-    for (int k = 0; k < 4 && box_there; ++k) o.obstacles.emplace_back(2.0 + 0.01 * k, y);
-    for (double x = 0.8; x <= (box_there ? 1.95 : 3.0); x += 0.02) o.ground.emplace_back(x, y);
+    for (int k = 0; k < 4 && box_there; ++k) view.obstacles.emplace_back(2.0 + 0.01 * k, y);
+    for (double x = 0.8; x <= (box_there ? 1.95 : 3.0); x += 0.02) view.ground.emplace_back(x, y);
   }
+  o.views.push_back(view);
   return o;
 }
 
@@ -60,26 +64,42 @@ TEST(ObstacleLayer, MarksWhatIsSeenClearsWhatIsSeenFreeAndForgets) {
   layer.Integrate(SeeBox(10.4, true));
   layer.Integrate(SeeBox(10.8, true));
   ASSERT_GT(layer.OccupiedCells(), 0);
-  ObstacleObservation nothing;
+  ObstacleObservation nothing;  // no view: time passes
   nothing.stamp = 10.8 + 3.0 * parameters.decay_time;
   layer.Integrate(nothing);
   EXPECT_EQ(layer.OccupiedCells(), 0);
 }
 
-// The window rolls with the robot: what it saw stays where it is in the map frame.
+// The window rolls with the robot: every cell it keeps holds the same value at the same place in
+// the map frame.
 TEST(ObstacleLayer, RollsWithTheRobotKeepingCellsInPlace) {
-  ObstacleLayer layer(EmptyMap(), ObstacleLayerParameters{});
+  ObstacleLayerParameters parameters;
+  parameters.decay_time = 1e6;  // no fading between the two looks
+  ObstacleLayer layer(EmptyMap(), parameters);
   layer.Integrate(SeeBox(0.0, true));
   layer.Integrate(SeeBox(0.1, true));
-  const int before = layer.OccupiedCells();
-  ASSERT_GT(before, 0);
+  ASSERT_GT(layer.OccupiedCells(), 0);
+  std::vector<std::pair<Eigen::Vector2d, double>> before;
+  for (double x = 0.525; x < 3.0; x += 0.05) {
+    for (double y = -0.475; y < 0.5; y += 0.05) before.push_back({{x, y}, layer.LogOdds({x, y})});
+  }
   ObstacleObservation moved;
   moved.stamp = 0.2;
-  moved.sensor = {4.0, 1.0};  // beyond a quarter of the window: it recentres
+  ObstacleView view;
+  view.sensor = {4.0, 1.0};  // beyond a quarter of the window: it recentres
+  moved.views.push_back(view);
   layer.Integrate(moved);
   EXPECT_NEAR(layer.origin().x(), 4.0 - 6.0, 0.051);
-  EXPECT_EQ(layer.OccupiedCells(), before);
-  EXPECT_GT(OccupiedIn(layer, {1.95, -0.25}, {2.1, 0.25}), 0);
+  for (const auto& [point, value] : before) EXPECT_NEAR(layer.LogOdds(point), value, 1e-4) << point.transpose();
+}
+
+// Two pairs seeing the same cell in one frame count once.
+TEST(ObstacleLayer, ACellSeenByTwoPairsInOneFrameCountsOnce) {
+  ObstacleLayer layer(EmptyMap(), ObstacleLayerParameters{});
+  ObstacleObservation both = SeeBox(0.0, true);
+  both.views.push_back(both.views.front());
+  layer.Integrate(both);
+  EXPECT_EQ(layer.OccupiedCells(), 0) << "one frame, however many pairs, is one hit";
 }
 
 // Rendered: the front stereo pair sees a 0.4 x 0.4 x 0.3 m box 2.1 m ahead on the lawn (1.8 m from
@@ -111,10 +131,12 @@ class RenderedObstacle : public ::testing::Test {
       ASSERT_TRUE(points.ground_fitted);
       ObstacleObservation o;
       o.stamp = *stamp;
-      o.sensor = points.sensor.head<2>();  // base_link is the map frame here
-      o.sensor_height = points.ground.Distance(points.sensor);
-      for (const auto& p : points.obstacles) o.obstacles.push_back(p.head<2>());
-      for (const auto& p : points.ground_points) o.ground.push_back(p.head<2>());
+      ObstacleView view;
+      view.sensor = points.sensor.head<2>();  // base_link is the map frame here
+      view.sensor_height = points.ground.Distance(points.sensor);
+      for (const auto& p : points.obstacles) view.obstacles.push_back(p.head<2>());
+      for (const auto& p : points.ground_points) view.ground.push_back(p.head<2>());
+      o.views.push_back(view);
       layer->Integrate(o);
       *stamp += 0.4;
     }

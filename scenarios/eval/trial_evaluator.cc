@@ -108,14 +108,12 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
     }
     if (event.type == Type::kRecovered) ++recoveries_;
     const bool known_goal = event.goal >= 0 && event.goal < static_cast<int>(goals_.size());
-    if (event.type == Type::kGoalAdjusted && known_goal) {
+    if (event.type == Type::kGoalReached && known_goal) {
+      // Judged where the robot meant to arrive: the asked goal, or where it moved it (reported).
       GoalResult& goal = goals_[event.goal];
       goal.used_x = event.position.x();
       goal.used_y = event.position.y();
       goal.adjusted_by_m = std::hypot(goal.used_x - goal.x, goal.used_y - goal.y);
-    }
-    if (event.type == Type::kGoalReached && known_goal) {
-      GoalResult& goal = goals_[event.goal];
       goal.arrival_time = step.time;
       goal.final_error_m = std::hypot(truth.x - goal.used_x, truth.y - goal.used_y);
       goal.reached = goal.final_error_m <= goal_tolerance_;

@@ -127,10 +127,14 @@ Eigen::Vector2d MapSize(const garden::OccupancyMap& map) {
   return {map.occupied.cols * map.resolution, map.occupied.rows * map.resolution};
 }
 
-cv::Mat RenderMap(const garden::OccupancyMap& map, cv::Size size_px, const MapToImage& to_image) {
+const cv::Scalar kNotInMap(215, 140, 70);  // orange (RGB, as every colour here): in the world, not in the map
+
+cv::Mat RenderMap(const garden::OccupancyMap& map, const garden::OccupancyMap& world, cv::Size size_px,
+                  const MapToImage& to_image) {
   const cv::Scalar kFree(248, 248, 244), kOccupied(90, 90, 90), kGridLine(222, 222, 218);
-  cv::Mat occupied;
+  cv::Mat occupied, in_world;
   cv::resize(map.occupied, occupied, size_px, 0, 0, cv::INTER_NEAREST);
+  cv::resize(world.occupied, in_world, size_px, 0, 0, cv::INTER_NEAREST);
   cv::Mat image(size_px, CV_8UC3, kFree);
   // 1 m grid, on free space only, to read distances anywhere on the map.
   const Eigen::Vector2d low = map.origin, high = map.origin + MapSize(map);
@@ -143,8 +147,13 @@ cv::Mat RenderMap(const garden::OccupancyMap& map, cv::Size size_px, const MapTo
     cv::line(image, FixedPoint(to_image({low.x(), y}) + shift), FixedPoint(to_image({high.x(), y}) + shift), kGridLine, 1,
              cv::LINE_8, kSubpixelBits);
   }
+  image.setTo(kNotInMap, in_world & ~occupied);
   image.setTo(kOccupied, occupied);
   return image;
+}
+
+bool MapLacksSomething(const garden::OccupancyMap& map, const garden::OccupancyMap& world) {
+  return cv::countNonZero(world.occupied & ~map.occupied) > 0;
 }
 
 int LegendHeight(std::size_t trajectories) {
@@ -154,7 +163,7 @@ int LegendHeight(std::size_t trajectories) {
 }
 
 void DrawLegend(cv::Mat& image, int top, const std::vector<PlotTrajectory>& trajectories,
-                const std::vector<TrialColours>& colours, double pixels_per_metre) {
+                const std::vector<TrialColours>& colours, double pixels_per_metre, bool not_in_map) {
   const cv::Scalar kKeyGrey(110, 110, 110);
   int y = top + kLegendMargin + kLegendRowHeight / 2;
   int x = kLegendMargin;
@@ -177,6 +186,11 @@ void DrawLegend(cv::Mat& image, int top, const std::vector<PlotTrajectory>& traj
   x += 18 + TextSize("start", 0.5, 1).width + 24;
   DrawGoal(image, {x + 13, y}, 1);
   PutText(image, "goals, in order", {x + 34, y + 6}, 0.5, kInk);
+  x += 34 + TextSize("goals, in order", 0.5, 1).width + 24;
+  if (not_in_map) {
+    cv::rectangle(image, {x, y - 6}, {x + 14, y + 6}, kNotInMap, cv::FILLED);
+    PutText(image, "in the garden, not in the robot's map", {x + 22, y + 6}, 0.5, kInk);
+  }
 
   const int per_row = std::max(1, (kPlotWidth - 2 * kLegendMargin) / kLegendEntryWidth);
   for (std::size_t i = 0; i < trajectories.size(); ++i) {
@@ -368,7 +382,7 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary) {
   WriteFileAtomically(path, xml.str());
 }
 
-void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map,
+void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
                          const std::vector<PlotTrajectory>& trajectories,
                          const std::vector<Eigen::Vector2d>& goals, const std::string& title) {
   const Eigen::Vector2d map_size = MapSize(map);
@@ -387,7 +401,10 @@ void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& ma
   const int legend_top = kTitleBandHeight + map_px.height;
   cv::Mat image(legend_top + LegendHeight(trajectories.size()), kPlotWidth, CV_8UC3, kWhite);
   const cv::Rect map_area(cv::Point(static_cast<int>(to_image.offset.x), kTitleBandHeight), map_px);
-  RenderMap(map, map_px, to_image).copyTo(image(map_area));
+  if (world.occupied.size() != map.occupied.size()) {
+    throw std::invalid_argument(path + ": the world's map must have the prior map's cells");
+  }
+  RenderMap(map, world, map_px, to_image).copyTo(image(map_area));
   cv::rectangle(image, map_area, cv::Scalar(150, 150, 150), 1);
   PutText(image, title, {kLegendMargin, 32}, 0.8, kInk, 2);
 
@@ -416,7 +433,7 @@ void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& ma
     DrawGoal(image, {static_cast<int>(std::lround(centre.x)), static_cast<int>(std::lround(centre.y))},
              static_cast<int>(g) + 1);
   }
-  DrawLegend(image, legend_top, trajectories, colours, to_image.pixels_per_metre);
+  DrawLegend(image, legend_top, trajectories, colours, to_image.pixels_per_metre, MapLacksSomething(map, world));
   WritePng(path, image, true);
 }
 

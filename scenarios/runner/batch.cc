@@ -164,7 +164,7 @@ std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<T
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.
 int WriteReports(const std::string& out, const Scenario& scenario, const garden::OccupancyMap& map,
-                 const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
+                 const garden::OccupancyMap& world, const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   BatchSummary summary;
   summary.scenario = scenario.name;
@@ -196,7 +196,7 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
     if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
     trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
   }
-  WriteTrajectoryPlot(out + "/trajectories.png", map, trajectories, scenario.goals,
+  WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, scenario.goals,
                       scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
   WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
 
@@ -403,7 +403,7 @@ int RunBatch(const BatchOptions& options) {
     }
     if (interactive && !running.empty()) PrintProgress(running, results.size(), planned, scenario, batch_start);
   }
-  return WriteReports(out, scenario, map, info, results, planned, log);
+  return WriteReports(out, scenario, map, WorldMap(scenario, options.paths), info, results, planned, log);
 }
 
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths) {
@@ -447,7 +447,8 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
               << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
-  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), merged, found, merged.trials, std::cout);
+  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths), merged, found,
+                      merged.trials, std::cout);
 }
 
 }  // namespace trimbot::scenarios

@@ -17,6 +17,20 @@ namespace trimbot::scenarios {
 
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
   garden::Garden surveyed = built;
+  for (std::size_t i = 0; i < survey.unmapped_objects.size(); ++i) {
+    const garden::GardenObject& extra = survey.unmapped_objects[i];
+    for (std::size_t j = 0; j < i; ++j) {
+      if (survey.unmapped_objects[j].id == extra.id) {
+        throw InputError(scenario_file, "survey.unmapped_objects: id " + std::to_string(extra.id) + " is used twice");
+      }
+    }
+    for (const garden::GardenObject& object : built.objects) {
+      if (object.id == extra.id) {
+        throw InputError(scenario_file, "survey.unmapped_objects: id " + std::to_string(extra.id) +
+                                            " is already an object of garden '" + built.name + "'");
+      }
+    }
+  }
   for (int id : survey.unmapped) {
     const auto it = std::find_if(surveyed.objects.begin(), surveyed.objects.end(),
                                  [id](const garden::GardenObject& o) { return o.id == id; });
@@ -39,6 +53,16 @@ garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& path
   const garden::Garden built = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
   const garden::Garden surveyed = SurveyedGarden(built, scenario.survey, scenario.source);
   return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, scenario.map_clearance_height);
+}
+
+garden::OccupancyMap WorldMap(const Scenario& scenario, const ProjectPaths& paths) {
+  garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  world.objects.insert(world.objects.end(), scenario.survey.unmapped_objects.begin(),
+                       scenario.survey.unmapped_objects.end());
+  Survey as_grown;
+  as_grown.growth = scenario.world.conditions.growth;
+  return garden::MakeOccupancyMap(SurveyedGarden(world, as_grown, scenario.source), scenario.map_resolution,
+                                  scenario.map_clearance_height);
 }
 
 std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir) {

@@ -21,6 +21,9 @@ garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey,
 
 // The robot's prior map: the surveyed garden's objects below the clearance height.
 garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& paths);
+// The garden as it is in the trial's world - its objects, the scenario's unmapped objects, foliage
+// at the conditions' growth - on the prior map's cells (for plots: what the robot's map lacks).
+garden::OccupancyMap WorldMap(const Scenario& scenario, const ProjectPaths& paths);
 // Writes it (map_server) as <dir>/map.{png,yaml}; returns the YAML's path.
 std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir);
 

@@ -73,6 +73,11 @@ Survey ReadSurvey(const YamlMap& map) {
   if (map.Has("gone")) {
     for (const YamlMap& item : map.MapList("gone")) survey.gone.push_back(garden::ReadGardenObject(item));
   }
+  if (map.Has("unmapped_objects")) {
+    for (const YamlMap& item : map.MapList("unmapped_objects")) {
+      survey.unmapped_objects.push_back(garden::ReadGardenObject(item));
+    }
+  }
   map.RejectUnknownKeys();
   return survey;
 }

@@ -30,6 +30,9 @@ struct PassCriterion {
 struct Survey {
   double growth = 0.0;                    // foliage as it was when surveyed (0..1, as Conditions)
   std::vector<int> unmapped;              // object ids the survey missed
+  // Objects in the world that are not in the garden file either (a wheelbarrow left on the lawn):
+  // placed in the simulated world, never in the map. Ids must not be the garden's.
+  std::vector<garden::GardenObject> unmapped_objects;
   std::vector<garden::GardenObject> gone;  // objects in the map that are no longer in the garden
 };
 

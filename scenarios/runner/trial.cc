@@ -12,12 +12,22 @@
 #include "runner/prior_knowledge.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
+#include "reports/output_files.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
 
 namespace trimbot::scenarios {
 namespace {
+
+// The navigator's costmap at the end: free white, the prior map grey, what only perception saw orange.
+void WriteCostmapImage(const std::string& path, const cv::Mat& layers) {
+  if (layers.empty()) return;
+  cv::Mat image(layers.size(), CV_8UC3, cv::Scalar(248, 248, 244));
+  image.setTo(cv::Scalar(90, 90, 90), layers == 128);
+  image.setTo(cv::Scalar(215, 140, 70), layers == 255);
+  WritePng(path, image, true);
+}
 
 // `render_for_stack`: the stack asks for the ring cameras it uses, when it uses them.
 sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
@@ -29,6 +39,7 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   config.cameras_on_schedule = !render_for_stack;
   config.resolution_scale = scenario.resolution_scale;
   config.faults = scenario.faults;
+  config.extra_objects = scenario.survey.unmapped_objects;
   config.imu_noise_scale = scenario.imu_noise_scale;
   config.wheel_slip_scale = scenario.wheel_slip_scale;
   return config;
@@ -87,6 +98,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   result.simulated_seconds = simulator.time();
   const auto report_start = std::chrono::steady_clock::now();
   evaluator.WriteFiles(setup.dir);
+  if (parameters.obstacles.enabled) WriteCostmapImage(setup.dir + "/costmap.png", robot.CostmapLayers());
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
   const auto seconds = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };

@@ -59,18 +59,22 @@ std::array<Plane, 6> ViewVolume(const mjvGLCamera& camera, double aspect) {
 // Keeps in the scene only the geoms that can show in this camera: those whose bounding sphere,
 // or the shadow it casts from a shadow-casting directional light down to the ground, meets the
 // view volume. What is dropped would be clipped by OpenGL anyway, so the image is the same; the
-// three passes of a shadowed scene (lit, shadow map, shadowed) then draw a fifth of the garden.
+// three passes of a shadowed scene (lit, shadow map, shadowed) then draw about half the garden.
 // Returns how many were dropped.
 int KeepVisibleGeoms(mjvScene* scene, double aspect) {
-  const std::array<Plane, 6> volume = ViewVolume(scene->camera[0], aspect);
+  // MuJoCo keeps two eyes ipd apart; a mono render draws from their average.
+  const mjvGLCamera camera = mjv_averageCamera(&scene->camera[0], &scene->camera[1]);
+  const std::array<Plane, 6> volume = ViewVolume(camera, aspect);
   std::vector<Vec3> shadow_directions;
   if (scene->flags[mjRND_SHADOW]) {
     for (int i = 0; i < scene->nlight; ++i) {
       const mjvLight& light = scene->lights[i];
-      if (light.castshadow && light.directional) shadow_directions.push_back(ToVec(light.dir).normalized());
+      if (!light.castshadow) continue;
+      if (!light.directional) return 0;  // a point or spot light's shadows are not swept: draw all
+      shadow_directions.push_back(ToVec(light.dir).normalized());
     }
   }
-  const double longest_shadow = scene->camera[0].frustum_far;
+  const double longest_shadow = camera.frustum_far;
   auto capsule_outside = [&](const Vec3& a, const Vec3& b, double radius) {
     for (const Plane& plane : volume) {
       if (plane.Distance(a) > radius && plane.Distance(b) > radius) return true;

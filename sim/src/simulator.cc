@@ -22,6 +22,22 @@ using robot::RobotFrames;
 
 namespace {
 
+// The garden file's objects plus the configuration's extra ones (ids must stay unique: labels and
+// contacts name objects by id).
+garden::Garden GardenWithExtraObjects(const SimulatorConfig& config) {
+  garden::Garden garden = garden::Garden::Load(config.garden_path);
+  for (const garden::GardenObject& extra : config.extra_objects) {
+    for (const garden::GardenObject& object : garden.objects) {
+      if (object.id == extra.id) {
+        throw InputError(config.garden_path, "an extra object has id " + std::to_string(extra.id) +
+                                                 ", which the garden already uses");
+      }
+    }
+    garden.objects.push_back(extra);
+  }
+  return garden;
+}
+
 // Number of physics steps per sensor sample; the rate must divide the physics rate.
 int StepsPerSample(double rate_hz, double timestep, const std::string& file, const std::string& sensor) {
   const double steps = 1.0 / (rate_hz * timestep);
@@ -67,7 +83,7 @@ Simulator::Simulator(const SimulatorConfig& config)
       parameters_(robot::RobotParameters::Load(config.robot.robot_parameters)),
       rig_(robot::CameraRig::LoadKalibr(config.robot.camchain,
                                         robot_.FramePose(RobotFrames::CameraOptical(0)))),
-      garden_(garden::Garden::Load(config.garden_path)),
+      garden_(GardenWithExtraObjects(config)),
       impl_(std::make_unique<Impl>()) {
   if (rig_.size() != 10) {
     throw InputError(config.robot.camchain, "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -32,29 +35,41 @@ void Navigator::SetCostmap(OccupancyGrid costmap) {
       costmap.origin() != map_.origin()) {
     throw std::invalid_argument("Navigator::SetCostmap: the costmap must have the prior map's cells");
   }
+  if (cv::countNonZero(costmap.occupied() != costmap_.occupied()) == 0) return;  // nothing new
   costmap_ = std::move(costmap);  // the planner refers to costmap_ itself
   costmap_changed_ = true;
 }
 
-bool Navigator::PathAheadBlocked(const Pose2& estimate) const {
+std::optional<Eigen::Vector2d> Navigator::PathAheadBlocked(const Pose2& estimate) const {
   const std::vector<Eigen::Vector2d>& path = follower_.path();
+  const std::size_t first = follower_.segment();
+  if (first + 1 >= path.size()) return std::nullopt;
+  // From the robot's projection onto the segment it drives, along the path for blocked_horizon.
   const Eigen::Vector2d robot(estimate.x, estimate.y);
+  const Eigen::Vector2d a0 = path[first], b0 = path[first + 1];
+  const double length0 = (b0 - a0).squaredNorm();
+  const double along0 = length0 > 0.0 ? std::clamp((robot - a0).dot(b0 - a0) / length0, 0.0, 1.0) : 0.0;
   const double step = 0.5 * costmap_.resolution();
-  double along = 0.0;
-  for (std::size_t i = follower_.segment() + 1; i < path.size(); ++i) {
-    const Eigen::Vector2d a = path[i - 1], b = path[i];
-    const double length = (b - a).norm();
+  double travelled = 0.0;
+  Eigen::Vector2d from = a0 + along0 * (b0 - a0);
+  for (std::size_t i = first + 1; i < path.size() && travelled <= parameters_.blocked_horizon; ++i) {
+    const Eigen::Vector2d to = path[i];
+    const double length = (to - from).norm();
     const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
     for (int k = 0; k <= steps; ++k) {
-      const Eigen::Vector2d q = a + (static_cast<double>(k) / steps) * (b - a);
-      // Right around the robot the obstacle stop guards it; the path starts where it stood.
+      const Eigen::Vector2d q = from + (static_cast<double>(k) / steps) * (to - from);
+      // Right around the robot the obstacle stop guards it; and only what perception added
+      // counts: the plan already kept its clearance from the prior map.
       if ((q - robot).norm() < parameters_.planner.start_footprint_free) continue;
-      if (costmap_.DistanceToObstacle(q) < parameters_.blocked_clearance) return true;
+      if (costmap_.DistanceToObstacle(q) < parameters_.blocked_clearance &&
+          map_.DistanceToObstacle(q) >= parameters_.blocked_clearance) {
+        return q;
+      }
     }
-    along += length;
-    if (along > parameters_.blocked_horizon) break;
+    travelled += length;
+    from = to;
   }
-  return false;
+  return std::nullopt;
 }
 
 void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
@@ -101,6 +116,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
     }
   }
   const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goal, plan_failures_);
+  active_goal_ = goal;
   planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
     Emit(stamp, NavigationEvent::Type::kPlanFailed, plan.message);
@@ -109,7 +125,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   }
   follower_.SetPath(plan.path);
   mode_ = Mode::kFollowing;
-  Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m");
+  Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m", active_goal_);
 }
 
 messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estimate) {
@@ -137,7 +153,7 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   // Following.
   const FollowerOutput follow = follower_.Update(estimate);
   if (follow.arrived) {
-    Emit(stamp, NavigationEvent::Type::kGoalReached);
+    Emit(stamp, NavigationEvent::Type::kGoalReached, {}, active_goal_);
     ++goal_;
     recoveries_ = 0;
     plan_failures_ = 0;
@@ -158,8 +174,28 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   }
   if (costmap_changed_) {
     costmap_changed_ = false;
-    if (PathAheadBlocked(estimate)) {
-      Emit(stamp, NavigationEvent::Type::kPathBlocked);
+    if (const auto blocked = PathAheadBlocked(estimate)) {
+      std::ostringstream where;
+      where << std::fixed << std::setprecision(2) << "at (" << blocked->x() << " " << blocked->y() << ")";
+      // The seen obstacle cell nearest to that point, for the log.
+      const cv::Point centre = costmap_.Cell(*blocked);
+      const int reach = static_cast<int>(std::ceil(parameters_.blocked_clearance / costmap_.resolution()));
+      double nearest = std::numeric_limits<double>::infinity();
+      Eigen::Vector2d seen = *blocked;
+      for (int dr = -reach; dr <= reach; ++dr) {
+        for (int dc = -reach; dc <= reach; ++dc) {
+          const cv::Point cell(centre.x + dc, centre.y + dr);
+          if (cell.x < 0 || cell.y < 0 || cell.x >= costmap_.occupied().cols || cell.y >= costmap_.occupied().rows) continue;
+          if (costmap_.occupied().at<std::uint8_t>(cell) == 0 || map_.occupied().at<std::uint8_t>(cell) != 0) continue;
+          const Eigen::Vector2d p = costmap_.CellCentre(cell);
+          if ((p - *blocked).norm() < nearest) {
+            nearest = (p - *blocked).norm();
+            seen = p;
+          }
+        }
+      }
+      where << ", seen obstacle at (" << seen.x() << " " << seen.y() << ")";
+      Emit(stamp, NavigationEvent::Type::kPathBlocked, where.str(), *blocked);
       mode_ = Mode::kIdle;
       return stop;
     }

@@ -51,31 +51,32 @@ void ObstacleLayer::Integrate(const ObstacleObservation& observation) {
     log_odds_ *= std::exp(-elapsed / parameters_.decay_time);
   }
   last_stamp_ = observation.stamp;
+  if (observation.views.empty()) return;
   // Keep the robot in the middle half of the window.
+  const Eigen::Vector2d robot = observation.views.front().sensor;
   const Eigen::Vector2d centre = origin_ + Eigen::Vector2d::Constant(0.5 * cells_ * resolution_);
-  if ((observation.sensor - centre).cwiseAbs().maxCoeff() > 0.25 * cells_ * resolution_ || first) {
-    Recentre(observation.sensor);
-  }
+  if (first || (robot - centre).cwiseAbs().maxCoeff() > 0.25 * cells_ * resolution_) Recentre(robot);
 
   cv::Mat hits = cv::Mat::zeros(cells_, cells_, CV_16U);
-  for (const Eigen::Vector2d& point : observation.obstacles) {
-    if (const auto cell = CellOf(point)) {
-      auto& count = hits.at<std::uint16_t>(*cell);
-      if (count < 65535) ++count;
-    }
-  }
-  // A ground point at distance r is seen along a ray that is below the obstacle height only over
-  // its last min_height / sensor_height of the way: only that part is seen free.
   cv::Mat seen_free = cv::Mat::zeros(cells_, cells_, CV_8U);
-  const double free_from =
-      std::clamp(1.0 - observation.min_obstacle_height / std::max(observation.sensor_height, 1e-6), 0.0, 1.0);
-  for (const Eigen::Vector2d& end : observation.ground) {
-    const Eigen::Vector2d start = observation.sensor + free_from * (end - observation.sensor);
-    const double length = (end - start).norm();
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / (0.5 * resolution_))));
-    for (int i = 0; i <= steps; ++i) {
-      if (const auto cell = CellOf(start + (static_cast<double>(i) / steps) * (end - start))) {
-        seen_free.at<std::uint8_t>(*cell) = 1;
+  for (const ObstacleView& view : observation.views) {
+    for (const Eigen::Vector2d& point : view.obstacles) {
+      if (const auto cell = CellOf(point)) {
+        auto& count = hits.at<std::uint16_t>(*cell);
+        if (count < 65535) ++count;
+      }
+    }
+    // A ground point at distance r is seen along a ray that is below the obstacle height only over
+    // its last min_height / sensor_height of the way: only that part is seen free.
+    const double free_from =
+        std::clamp(1.0 - observation.min_obstacle_height / std::max(view.sensor_height, 1e-6), 0.0, 1.0);
+    for (const Eigen::Vector2d& end : view.ground) {
+      const Eigen::Vector2d start = view.sensor + free_from * (end - view.sensor);
+      const int steps = std::max(1, static_cast<int>(std::ceil((end - start).norm() / (0.5 * resolution_))));
+      for (int i = 0; i <= steps; ++i) {
+        if (const auto cell = CellOf(start + (static_cast<double>(i) / steps) * (end - start))) {
+          seen_free.at<std::uint8_t>(*cell) = 1;
+        }
       }
     }
   }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
@@ -114,6 +115,10 @@ std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const 
 RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed)
     : parameters_(parameters), components_(std::make_unique<Components>(files, parameters)) {
   SeedPlanner(seed);
+  if (components_->obstacle_stereo && PairsAhead().empty()) {
+    throw std::invalid_argument("stack parameters: perception.obstacles.max_bearing_deg leaves no stereo pair "
+                                "facing forward");
+  }
   components_->latency_rng = MakeRng(seed, "visual_localization_latency");
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
@@ -135,6 +140,13 @@ void RobotStack::SetMap(const std::string& map_yaml) {
   if (components_->obstacle_stereo) {
     components_->obstacle_layer = std::make_unique<ObstacleLayer>(*components_->map, parameters_.obstacles.layer);
   }
+}
+
+cv::Mat RobotStack::CostmapLayers() const {
+  if (!components_->navigator) return {};
+  cv::Mat layers = components_->navigator->costmap().occupied().clone();  // 255 where occupied
+  layers.setTo(128, components_->map->occupied());
+  return layers;
 }
 
 void RobotStack::SetVisualMap(const std::string& map_path) {
@@ -247,7 +259,6 @@ void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
                        [camera](const messages::Image& image) { return image.camera_index == camera; });
   };
   const Eigen::Isometry3d T_map_base = ToIsometry(c.ekf.Estimate().pose);
-  const double min_height = parameters_.obstacles.points.min_height;
   perception::ObstaclePointOptions options = parameters_.obstacles.points;
   // The robot's own body (base, ring, arm at rest) is the footprint's box with a margin.
   const Footprint& footprint = parameters_.navigation.planner.footprint;
@@ -255,29 +266,28 @@ void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
   const double margin = 0.05;
   options.robot_min = {*lowest - footprint.circle_radius - margin, -footprint.circle_radius - margin};
   options.robot_max = {*highest + footprint.circle_radius + margin, footprint.circle_radius + margin};
-  bool integrated = false;
+  ObstacleObservation observation;
+  observation.stamp = frame.stamp;
+  observation.min_obstacle_height = options.min_height;
   for (int pair : PairsAhead()) {
     const perception::StereoRectifier& rectifier = c.obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)];
     if (!has(rectifier.pair().left) || !has(rectifier.pair().right)) continue;  // not delivered
     const perception::RingStereo::PairResult result = c.obstacle_stereo->ComputePair(frame, pair);
     const perception::ObstaclePoints points =
         perception::FindObstaclePoints(result.cloud, rectifier.T_base_rectified_left().translation(), options);
-    ObstacleObservation observation;
-    observation.stamp = frame.stamp;
-    const Eigen::Vector3d sensor = T_map_base * points.sensor;
-    observation.sensor = sensor.head<2>();
-    observation.sensor_height = points.ground.Distance(points.sensor);
-    observation.min_obstacle_height = min_height;
-    observation.obstacles.reserve(points.obstacles.size());
-    for (const Eigen::Vector3d& p : points.obstacles) observation.obstacles.push_back((T_map_base * p).head<2>());
-    observation.ground.reserve(points.ground_points.size());
-    for (const Eigen::Vector3d& p : points.ground_points) observation.ground.push_back((T_map_base * p).head<2>());
-    c.obstacle_layer->Integrate(observation);
+    ObstacleView view;
+    view.sensor = (T_map_base * points.sensor).head<2>();
+    view.sensor_height = points.ground.Distance(points.sensor);
+    view.obstacles.reserve(points.obstacles.size());
+    for (const Eigen::Vector3d& p : points.obstacles) view.obstacles.push_back((T_map_base * p).head<2>());
+    view.ground.reserve(points.ground_points.size());
+    for (const Eigen::Vector3d& p : points.ground_points) view.ground.push_back((T_map_base * p).head<2>());
+    observation.views.push_back(std::move(view));
     ++telemetry_.timings.obstacle_pairs;
-    ++telemetry_.obstacles.frames;
-    integrated = true;
   }
-  if (!integrated) return;
+  if (observation.views.empty()) return;
+  c.obstacle_layer->Integrate(observation);
+  ++telemetry_.obstacles.frames;
   telemetry_.obstacles.occupied_cells = c.obstacle_layer->OccupiedCells();
   if (c.navigator) {
     c.navigator->SetCostmap(c.obstacle_layer->MergedWith(*c.map));
@@ -374,6 +384,7 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   if (LocalizationLost()) {
     // Better to stand than to drive blind: wait for the localization to come back.
     commands->base = messages::BaseVelocityCommand{};
+    last_linear_command_ = 0.0;
     ++telemetry_.visual.stopped_updates;
     return;
   }

@@ -138,10 +138,13 @@ void ReadNavigation(Reader& r, StackParameters& s) {
   r.Number("replan_deviation", &p.replan_deviation, 0.01, 100.0, "m");
   r.Integer("max_recoveries_per_goal", &p.max_recoveries_per_goal, 0, 1000);
   r.Integer("max_plan_failures", &p.max_plan_failures, 1, 1000);
-  r.Number("goal_search_radius", &p.goal_search_radius, 0.0, 10.0, "m");
+  r.Number("goal_search_radius", &p.goal_search_radius, 0.0, 2.0, "m");
   r.Number("blocked_clearance", &p.blocked_clearance, 0.0, 5.0, "m");
   r.Number("blocked_horizon", &p.blocked_horizon, 0.0, 100.0, "m");
   if (p.resume_clearance < p.stop_clearance) r.map().Fail("resume_clearance", "must be at least stop_clearance");
+  if (p.blocked_clearance >= p.planner.robot_radius) {
+    r.map().Fail("blocked_clearance", "must be less than planner.robot_radius (every new path would be blocked)");
+  }
   if (p.follower.min_speed > p.follower.cruise_speed) {
     r.map().Fail("follower", "min_speed must not exceed cruise_speed");
   }

@@ -35,6 +35,9 @@ class World;
 struct SimulatorConfig {
   robot::RobotFiles robot;           // urdf, camchain (the cameras as they really are), parameters
   std::string garden_path;
+  // Objects placed in the world beyond the garden file's (a scenario's obstacles the survey never
+  // saw); their ids must not be the garden's.
+  std::vector<garden::GardenObject> extra_objects;
   std::string world_dir;             // where world.xml and its textures are written
   std::uint64_t seed = 0;
   garden::Conditions conditions;     // time of day, shadows, growth

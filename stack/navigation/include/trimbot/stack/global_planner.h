@@ -1,10 +1,10 @@
 #pragma once
-// Global path planning over the robot's prior map with OMPL: RRT* in the plane for base_link,
-// keeping `robot_radius` from every occupied cell, and along every path segment keeping the
-// footprint - pointing along the segment, as the robot drives it - `footprint_margin` clear;
-// then shortcut-simplified. The planner runs for
-// a fixed number of iterations (not a time budget), so with OMPL's seed fixed (ompl::RNG::setSeed,
-// once per process) the same problem gives the same path on any machine.
+// Global path planning with OMPL over the robot's costmap (the prior map and what perception has
+// seen): RRT* in the plane for base_link, keeping `robot_radius` from every occupied cell, and
+// along every path segment keeping the footprint - pointing along the segment, as the robot
+// drives it - `footprint_margin` clear; then shortcut-simplified. The planner runs for a fixed
+// number of iterations (not a time budget), so with OMPL's seed fixed (ompl::RNG::setSeed, once
+// per process) the same problem gives the same path on any machine.
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>

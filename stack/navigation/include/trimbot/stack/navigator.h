@@ -3,10 +3,12 @@
 // obstacles perception has seen, SetCostmap), follow the path, plan again when what is seen
 // blocks it, and when the robot (by its estimate) gets too close to an obstacle, stop, back off
 // and plan again - the recovery behaviour of the real robot's navigation. A goal inside an
-// obstacle's clearance is moved to the nearest free point within goal_search_radius (reported). A system with explicit input
+// obstacle's clearance (robot_radius) is moved to the nearest point the robot can arrive at from
+// any direction (GlobalPlanner::ArrivalClearance), within goal_search_radius (reported). A system with explicit input
 // (time, pose estimate), output (base velocity command) and state (goal, path, mode); the events it
 // reports (goal reached, replans, recoveries, failures) go to the evaluation.
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,8 +31,9 @@ struct NavigatorParameters {
   int max_recoveries_per_goal = 5;
   int max_plan_failures = 3;         // per goal, then the goal is given up
   double goal_search_radius = 0.6;   // m: a goal in an obstacle's clearance moves at most this far
-  double blocked_clearance = 0.35;   // m: base_link's clearance along the path ahead below which
-                                     // the path counts as blocked (the planner keeps robot_radius)
+  double blocked_clearance = 0.35;   // m: base_link's clearance from a seen obstacle along the path
+                                     // ahead below which it counts as blocked (< robot_radius, which
+                                     // the planner keeps)
   double blocked_horizon = 4.0;      // m of path ahead checked when the costmap changes
 };
 
@@ -44,7 +47,9 @@ struct NavigationEvent {
   Type type = Type::kPlanned;
   int goal = 0;
   std::string detail;
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // kGoalAdjusted: the goal used
+  // kPlanned, kGoalReached: the goal planned to / arrived at (the asked one, or where it was
+  // moved); kGoalAdjusted: where the goal was moved; kPathBlocked: the blocked point of the path.
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
 };
 const char* ToString(NavigationEvent::Type type);
 
@@ -53,6 +58,9 @@ class Navigator {
   enum class Mode { kIdle, kFollowing, kBackingOff, kDone, kFailed };
 
   Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters);
+  // The planner refers to this navigator's costmap: not copied or moved.
+  Navigator(const Navigator&) = delete;
+  Navigator& operator=(const Navigator&) = delete;
 
   void SetGoals(const std::vector<Eigen::Vector2d>& goals);
   // The prior map with what perception has seen added (same size, resolution and origin as the
@@ -77,8 +85,9 @@ class Navigator {
   void GiveUpGoal(double stamp, const std::string& why);
   void Emit(double stamp, NavigationEvent::Type type, const std::string& detail = {},
             const Eigen::Vector2d& position = Eigen::Vector2d::Zero());
-  // base_link would come closer than blocked_clearance to an obstacle on the path ahead.
-  bool PathAheadBlocked(const Pose2& estimate) const;
+  // The first point of the path ahead where base_link would come closer than blocked_clearance
+  // to an obstacle perception added to the prior map; nullopt if none.
+  std::optional<Eigen::Vector2d> PathAheadBlocked(const Pose2& estimate) const;
 
   const OccupancyGrid& map_;
   OccupancyGrid costmap_;  // the planner plans on this
@@ -94,6 +103,7 @@ class Navigator {
   std::vector<NavigationEvent> events_;
   double planning_seconds_ = 0.0;
   bool costmap_changed_ = false;
+  Eigen::Vector2d active_goal_ = Eigen::Vector2d::Zero();  // the goal of the current plan
 };
 
 }  // namespace trimbot::stack

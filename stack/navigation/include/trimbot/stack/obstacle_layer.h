@@ -24,14 +24,19 @@ struct ObstacleLayerParameters {
   int min_points = 5;               // obstacle points in a cell in one frame for a hit (speckle)
 };
 
-// One stereo observation in the map frame.
-struct ObstacleObservation {
-  double stamp = 0.0;
+// What one stereo pair saw, in the map frame.
+struct ObstacleView {
   Eigen::Vector2d sensor = Eigen::Vector2d::Zero();  // camera position
   double sensor_height = 0.5;                        // m above the ground
-  double min_obstacle_height = 0.1;                  // m: what counts as an obstacle
   std::vector<Eigen::Vector2d> obstacles;            // obstacle points
   std::vector<Eigen::Vector2d> ground;               // ground points
+};
+
+// One frame's observation: every pair's view at one stamp (a cell seen by two pairs counts once).
+struct ObstacleObservation {
+  double stamp = 0.0;
+  double min_obstacle_height = 0.1;  // m: what counts as an obstacle
+  std::vector<ObstacleView> views;
 };
 
 class ObstacleLayer {

@@ -10,6 +10,7 @@
 //       stack.SetInitialPose(0, believed_start);  stack.SetMap(map_yaml);  stack.SetGoals(goals);
 //       per sensor message: stack.Add(message);   then: commands = stack.Update(now);
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -121,6 +122,9 @@ class RobotStack {
   messages::RobotCommands Update(double stamp);
 
   const Telemetry& telemetry() const { return telemetry_; }
+  // The navigator's costmap on the prior map's cells (CV_8U, row 0 = the map's top): 0 free,
+  // 128 an obstacle of the prior map, 255 an obstacle only perception has seen. Empty before SetMap.
+  cv::Mat CostmapLayers() const;
   const StackParameters& parameters() const { return parameters_; }
 
  private:
