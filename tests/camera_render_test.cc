@@ -279,6 +279,38 @@ TEST(FrustumCulling, DrawsTheSameImagesWithFewerGeoms) {
   }
 }
 
+// Nothing stands in the sun: the sun's shadows must change nothing on the ground (a gravel path
+// on the lawn), at noon and with a low evening sun. Before the ground's slabs reached deep
+// enough, the ground shadowed itself in stripes ("acne") where the shadow map's texels spanned
+// more depth than the slab.
+TEST(GroundShadows, GroundWithNothingOnItDoesNotShadowItself) {
+  const std::string garden = testing::WriteTempFile(
+      "bare_path.yaml", "name: bare_path\nseed: 4\nsize: [24, 24]\nground: grass\n"
+                        "paths:\n  - {surface: gravel, centre: [6.0, 0.0], size: [10.0, 1.2]}\nobjects: []\n");
+  for (const double hour : {12.0, 18.0}) {
+    cv::Mat images[2];
+    for (const bool shadows : {false, true}) {
+      SimulatorConfig config = TestConfig(garden, shadows ? "bare_path_shadows" : "bare_path_flat", true);
+      config.conditions.time_of_day = hour;
+      config.conditions.shadows = shadows;
+      Simulator simulator(config);
+      messages::RingRequest front;
+      front.cameras = {0};
+      const RingCapture capture = simulator.CaptureRing(front, false);
+      const auto& image = capture.frame.images[0];
+      images[shadows] = cv::Mat(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.data.data())).clone();
+    }
+    // Rows above the bottom quarter: the robot's own shadow lies close in front of it.
+    const cv::Rect far(0, 0, images[0].cols, images[0].rows * 3 / 4);
+    cv::Mat difference;
+    cv::absdiff(images[0](far), images[1](far), difference);
+    cv::Mat grey;
+    cv::cvtColor(difference, grey, cv::COLOR_RGB2GRAY);
+    const double stripes = cv::countNonZero(grey > 12) / static_cast<double>(grey.total());
+    EXPECT_LT(stripes, 0.002) << "at " << hour << " h, pixels darkened by the ground's own shadow";
+  }
+}
+
 TEST(Determinism, SameSeedSameBytes) {
   const Recording a = Record(42, "determinism_a");
   const Recording b = Record(42, "determinism_b");
@@ -328,7 +360,9 @@ TEST(GroundAppearance, SiftFindsFeaturesOnEveryGroundType) {
       std::printf("SIFT: %zu keypoints on %s, garden seed %d (cam0, 752x480)\n", keypoints.size(), surface, seed);
       fewest = std::min(fewest, keypoints.size());
     }
-    EXPECT_GE(fewest, 300u) << surface;
+    // 250: the plainest ground, pavement, gives 278-307 (measured once the ground stopped
+    // shadowing itself; its stripes had added features of their own).
+    EXPECT_GE(fewest, 250u) << surface;
   }
 }
 

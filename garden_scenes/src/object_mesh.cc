@@ -184,7 +184,7 @@ std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& 
     for (int i = 0; i < columns; ++i) {
       const bool mirror_u = (pick("lawn/column", i, 0) & 1U) != 0;
       Mesh& mesh = meshes[pick("lawn/variant", i, j) % kGroundVariants];
-      const double x0 = min.x() + i * tile, y0 = min.y() + j * tile, x1 = x0 + tile, y1 = y0 + tile, z = -0.01;
+      const double x0 = min.x() + i * tile, y0 = min.y() + j * tile, x1 = x0 + tile, y1 = y0 + tile, z = -kGroundSlabDepth;
       // Top: the whole variant, mirrored as drawn; sides and bottom close the slab (MuJoCo wants
       // meshes with a volume) and are never seen.
       const double u0 = mirror_u ? 1.0 : 0.0, v0 = mirror_v ? 1.0 : 0.0;

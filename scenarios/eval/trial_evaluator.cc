@@ -1,5 +1,7 @@
 #include "eval/trial_evaluator.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
@@ -84,7 +86,30 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
   in_contact_ = contact;
 }
 
+void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const std::vector<double>& circle_x,
+                                      double circle_radius) {
+  // Distance from every free cell to the nearest occupied one (cells outside the map: unknown).
+  cv::Mat free = world.occupied == 0;
+  cv::distanceTransform(free, world_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  world_distance_ *= world.resolution;
+  world_origin_ = world.origin;
+  world_resolution_ = world.resolution;
+  circle_x_ = circle_x;
+  circle_radius_ = circle_radius;
+}
+
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
+  if (!world_distance_.empty()) {
+    for (double cx : circle_x_) {
+      const double x = truth.x + cx * std::cos(truth.yaw), y = truth.y + cx * std::sin(truth.yaw);
+      const int column = static_cast<int>(std::floor((x - world_origin_.x()) / world_resolution_));
+      const int row = world_distance_.rows - 1 - static_cast<int>(std::floor((y - world_origin_.y()) / world_resolution_));
+      if (column < 0 || row < 0 || column >= world_distance_.cols || row >= world_distance_.rows) continue;
+      // The cell's centre is within half a cell of the circle's: count that against the robot.
+      const double distance = world_distance_.at<float>(row, column) - 0.5 * world_resolution_;
+      min_clearance_ = std::min(min_clearance_, distance - circle_radius_);
+    }
+  }
   const stack::Pose2& estimate = step.telemetry->estimate.pose;
   const stack::Pose2& odometry = step.telemetry->odometry;
   sample_times_.push_back(step.time);
@@ -138,6 +163,7 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   result->path_length_m = path_length_;
   result->collisions = collisions_;
   result->contact_seconds = contact_seconds_;
+  if (std::isfinite(min_clearance_)) result->min_clearance_m = min_clearance_;
   result->simulated_seconds = telemetry.stamp;
   result->fixes_accepted = telemetry.localization.fixes_accepted;
   result->fixes_rejected = telemetry.localization.fixes_rejected;

@@ -6,11 +6,15 @@
 // wheel_odometry.tum, pose_fixes.tum (TUM, usable with evo) and events.csv.
 #include <Eigen/Core>
 #include <deque>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "eval/trial_result.h"
 #include "runner/closed_loop.h"
+#include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {
 
@@ -20,6 +24,9 @@ class TrialEvaluator : public Observer {
   TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance, double fix_history_seconds);
 
   void Observe(const StepView& step) override;
+  // Also measure the smallest clearance between the robot's footprint (circles of `circle_radius`
+  // at `circle_x` along base_link's x) at its true pose and the garden as it is (`world`).
+  void MeasureClearance(const garden::OccupancyMap& world, const std::vector<double>& circle_x, double circle_radius);
 
   // Completes `result` (status, goals, counts, errors) from what was observed; `finished`: the
   // stack ended its mission before the time limit.
@@ -56,6 +63,13 @@ class TrialEvaluator : public Observer {
   std::vector<double> sample_times_, fix_stamps_;  // for the localization rate
   long steps_ = 0;
   double timestep_ = 0.0;
+  // Clearance: metres from each world cell to the nearest occupied one (empty: not measured).
+  cv::Mat world_distance_;
+  Eigen::Vector2d world_origin_ = Eigen::Vector2d::Zero();
+  double world_resolution_ = 0.0;
+  std::vector<double> circle_x_;
+  double circle_radius_ = 0.0;
+  double min_clearance_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace trimbot::scenarios

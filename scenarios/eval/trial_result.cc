@@ -84,6 +84,7 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"localization_rate", t.localization_rate},
        {"faults", t.faults},
        {"estimates", t.estimates}};
+  if (t.min_clearance_m) j["min_clearance_m"] = *t.min_clearance_m;
 }
 
 void from_json(const nlohmann::json& j, TrialResult& t) {
@@ -105,6 +106,7 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   t.localization_rate = j.value("localization_rate", -1.0);
   j.at("faults").get_to(t.faults);
   j.at("estimates").get_to(t.estimates);
+  if (j.contains("min_clearance_m")) t.min_clearance_m = j.at("min_clearance_m").get<double>();
 }
 
 void to_json(nlohmann::json& j, const CriterionResult& c) {
@@ -133,6 +135,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   int successes = 0, completed = 0, collisions = 0, recoveries = 0, goals_reached = 0;
   int goals_per_trial = 0;
   double simulated_seconds = 0.0, path_length_m = 0.0;
+  std::optional<double> min_clearance_m;
   std::vector<double> localization_rates;
   std::vector<std::string> estimate_names;  // in order of first appearance
   std::map<std::string, std::vector<double>> pooled_position_m, pooled_heading_deg;
@@ -146,6 +149,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
         std::count_if(trial.goals.begin(), trial.goals.end(), [](const GoalResult& g) { return g.reached; }));
     simulated_seconds += trial.simulated_seconds;
     path_length_m += trial.path_length_m;
+    if (trial.min_clearance_m) min_clearance_m = std::min(min_clearance_m.value_or(*trial.min_clearance_m), *trial.min_clearance_m);
     if (trial.localization_rate >= 0.0) localization_rates.push_back(trial.localization_rate);
     for (const EstimateErrors& estimate : trial.estimates) {
       if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
@@ -166,6 +170,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   metrics["recoveries"] = recoveries;
   metrics["mean_trial_seconds"] = ratio(simulated_seconds, ran);
   metrics["mean_path_length_m"] = ratio(path_length_m, ran);
+  if (min_clearance_m) metrics["min_clearance_m"] = *min_clearance_m;  // over all trials
   if (!localization_rates.empty()) metrics["localization_rate"] = ErrorStats::From(localization_rates).mean;
   for (const std::string& name : estimate_names) {
     // An estimate without samples (e.g. no pose fix arrived) has no error metrics, so a criterion

@@ -4,6 +4,7 @@
 // the trial results into a BatchSummary with the scenario's pass criteria evaluated.
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,9 @@ struct TrialResult {
   double path_length_m = 0.0;      // ground truth
   int collisions = 0;              // separate contact events with garden objects
   double contact_seconds = 0.0;
+  // Smallest distance between the footprint at its true pose and the garden as it is (m,
+  // negative: overlap); absent when not measured.
+  std::optional<double> min_clearance_m;
   int replans = 0;
   int recoveries = 0;              // obstacle stops followed by a recovery manoeuvre
   int fixes_accepted = 0, fixes_rejected = 0, relocalizations = 0;

@@ -163,7 +163,8 @@ void ReadCriteria(const YamlMap& criteria, Scenario& s) {
 bool IsKnownMetric(const std::string& name) {
   static const std::set<std::string> kMetrics = [] {
     std::set<std::string> names = {"success_rate", "goal_success_rate", "trials_completed", "collisions",
-                                   "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate"};
+                                   "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate",
+                                   "min_clearance_m"};
     for (const char* estimate : {"ekf", "wheel_odometry", "pose_fixes"}) {
       for (const char* stat : {"mean", "median", "max", "rmse"}) {
         names.insert(std::string(estimate) + "_position_error_" + stat + "_m");

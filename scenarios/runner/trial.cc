@@ -85,6 +85,8 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   }
   TrialEvaluator evaluator(scenario.goals, scenario.goal_tolerance,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
+  const stack::Footprint& footprint = parameters.navigation.planner.footprint;
+  evaluator.MeasureClearance(WorldMap(scenario, setup.paths), footprint.circle_x, footprint.circle_radius);
   StackController controller(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;

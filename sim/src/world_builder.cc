@@ -324,8 +324,9 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
               "garden_surface");
     spec.labels.push_back({name, ObjectClass::kGround, garden::kGroundObjectId, true, garden.ground});
   }
-  // Paths and beds are flush with the lawn: drawn as 2 mm slabs that do not collide (a slab edge
-  // would stop a wheel); the simulator finds the surface under a wheel from the garden's paths.
+  // Paths and beds are flush with the lawn: slabs whose top is 2 mm above it (deep below it, see
+  // kGroundSlabDepth) that do not collide (a slab edge would stop a wheel); the simulator finds the
+  // surface under a wheel from the garden's paths.
   for (size_t i = 0; i < garden.paths.size(); ++i) {
     const auto& path = garden.paths[i];
     const garden::Material material = garden::GroundMaterial(path.surface);
@@ -333,7 +334,8 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
     garden::GardenObject slab;
     slab.position = path.centre;
     slab.yaw = path.yaw;
-    emit_mesh(name, garden::BoxMesh({path.size.x(), path.size.y(), 0.002}, garden::TileSize(material)),
+    slab.base_height = 0.002 - garden::kGroundSlabDepth;
+    emit_mesh(name, garden::BoxMesh({path.size.x(), path.size.y(), garden::kGroundSlabDepth}, garden::TileSize(material)),
               garden::ObjectPose(slab), garden::ToString(material), "garden_surface");
     spec.labels.push_back({name, ObjectClass::kGround, garden::kGroundObjectId, true, path.surface});
   }

@@ -21,10 +21,17 @@ struct Mesh {
   double Area() const;
 };
 
+// How far the ground's meshes (lawn patches, path slabs) reach below their top. MuJoCo 2.2 draws
+// the sun's shadow map from back faces, so a slab's own bottom is the occluder its top is tested
+// against; that bottom must lie deeper than the depth a shadow-map texel spans (~1.6 cm texels
+// over the Wageningen garden: 9 cm at a 10 deg sun), or the ground shadows itself in stripes
+// ("acne") that stereo matched as floating surfaces and that changed the ground's look with the hour.
+constexpr double kGroundSlabDepth = 0.15;  // m
+
 // Box of the given full size, base on z = 0, textured `tile` metres per texture repeat.
 Mesh BoxMesh(const Eigen::Vector3d& size, double tile);
 // The lawn, in the map frame, as one mesh per ground variant (textures.h): square patches of
-// `tile` metres covering [min, max] (grown to whole patches), each a 1 cm slab whose top (z = 0)
+// `tile` metres covering [min, max] (grown to whole patches), each a slab (kGroundSlabDepth) whose top (z = 0)
 // shows its variant once (texture coordinates 0..1). Variants are drawn per patch and whole
 // columns and rows of patches are mirrored, all by `seed`; mirroring whole columns and rows keeps
 // neighbours meeting on the same border texels, so the lawn has no seams and no period shorter
