@@ -128,6 +128,30 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m", active_goal_);
 }
 
+std::string Navigator::DescribeBlock(const Eigen::Vector2d& blocked) const {
+  // The seen obstacle cell nearest to the blocked point, for the log.
+  const cv::Point centre = costmap_.Cell(blocked);
+  const int reach = static_cast<int>(std::ceil(parameters_.blocked_clearance / costmap_.resolution()));
+  double nearest = std::numeric_limits<double>::infinity();
+  Eigen::Vector2d seen = blocked;
+  for (int dr = -reach; dr <= reach; ++dr) {
+    for (int dc = -reach; dc <= reach; ++dc) {
+      const cv::Point cell(centre.x + dc, centre.y + dr);
+      if (cell.x < 0 || cell.y < 0 || cell.x >= costmap_.occupied().cols || cell.y >= costmap_.occupied().rows) continue;
+      if (costmap_.occupied().at<std::uint8_t>(cell) == 0 || map_.occupied().at<std::uint8_t>(cell) != 0) continue;
+      const Eigen::Vector2d p = costmap_.CellCentre(cell);
+      if ((p - blocked).norm() < nearest) {
+        nearest = (p - blocked).norm();
+        seen = p;
+      }
+    }
+  }
+  std::ostringstream where;
+  where << std::fixed << std::setprecision(2) << "at (" << blocked.x() << " " << blocked.y()
+        << "), seen obstacle at (" << seen.x() << " " << seen.y() << ")";
+  return where.str();
+}
+
 messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estimate) {
   messages::BaseVelocityCommand stop;
   if (mode_ == Mode::kDone || mode_ == Mode::kFailed) return stop;
@@ -161,9 +185,15 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
     mode_ = goal_ < static_cast<int>(goals_.size()) ? Mode::kIdle : Mode::kDone;
     return stop;
   }
-  // Too close to an obstacle of the map while moving towards it: stop and back off.
-  if (FootprintClearance(estimate) < parameters_.stop_clearance && follow.command.linear > 0.0) {
-    Emit(stamp, NavigationEvent::Type::kObstacleStop);
+  // Too close to an obstacle while moving towards it - driving forward, or turning on the spot,
+  // which sweeps the footprint's front round (checked turn_check_angle ahead): stop and back off.
+  const bool turning_in_place = follow.command.linear == 0.0 && follow.command.angular != 0.0;
+  Pose2 turned = estimate;
+  turned.yaw += std::copysign(parameters_.turn_check_angle, follow.command.angular);
+  const bool too_close = (follow.command.linear > 0.0 && FootprintClearance(estimate) < parameters_.stop_clearance) ||
+                         (turning_in_place && FootprintClearance(turned) < parameters_.stop_clearance);
+  if (too_close) {
+    Emit(stamp, NavigationEvent::Type::kObstacleStop, turning_in_place ? "turning" : "driving");
     if (++recoveries_ > parameters_.max_recoveries_per_goal) {
       GiveUpGoal(stamp, "too many recoveries");
       return stop;
@@ -175,27 +205,7 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   if (costmap_changed_) {
     costmap_changed_ = false;
     if (const auto blocked = PathAheadBlocked(estimate)) {
-      std::ostringstream where;
-      where << std::fixed << std::setprecision(2) << "at (" << blocked->x() << " " << blocked->y() << ")";
-      // The seen obstacle cell nearest to that point, for the log.
-      const cv::Point centre = costmap_.Cell(*blocked);
-      const int reach = static_cast<int>(std::ceil(parameters_.blocked_clearance / costmap_.resolution()));
-      double nearest = std::numeric_limits<double>::infinity();
-      Eigen::Vector2d seen = *blocked;
-      for (int dr = -reach; dr <= reach; ++dr) {
-        for (int dc = -reach; dc <= reach; ++dc) {
-          const cv::Point cell(centre.x + dc, centre.y + dr);
-          if (cell.x < 0 || cell.y < 0 || cell.x >= costmap_.occupied().cols || cell.y >= costmap_.occupied().rows) continue;
-          if (costmap_.occupied().at<std::uint8_t>(cell) == 0 || map_.occupied().at<std::uint8_t>(cell) != 0) continue;
-          const Eigen::Vector2d p = costmap_.CellCentre(cell);
-          if ((p - *blocked).norm() < nearest) {
-            nearest = (p - *blocked).norm();
-            seen = p;
-          }
-        }
-      }
-      where << ", seen obstacle at (" << seen.x() << " " << seen.y() << ")";
-      Emit(stamp, NavigationEvent::Type::kPathBlocked, where.str(), *blocked);
+      Emit(stamp, NavigationEvent::Type::kPathBlocked, DescribeBlock(*blocked), *blocked);
       mode_ = Mode::kIdle;
       return stop;
     }

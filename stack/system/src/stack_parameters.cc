@@ -132,6 +132,7 @@ void ReadNavigation(Reader& r, StackParameters& s) {
   r.Section("planner", [&](Reader& f) { ReadPlanner(f, p.planner); });
   r.Section("follower", [&](Reader& f) { ReadFollower(f, p.follower); });
   r.Number("stop_clearance", &p.stop_clearance, -1.0, 2.0, "m");
+  r.Number("turn_check_angle", &p.turn_check_angle, 0.0, M_PI, "rad");
   r.Number("resume_clearance", &p.resume_clearance, 0.0, 5.0, "m");
   r.Number("backoff_speed", &p.backoff_speed, 0.01, 0.6, "m/s");
   r.Number("max_backoff", &p.max_backoff, 0.0, 10.0, "m");

@@ -24,6 +24,7 @@ struct NavigatorParameters {
   PlannerParameters planner;         // holds the footprint
   FollowerParameters follower;
   double stop_clearance = 0.03;      // m: footprint this close to the map's obstacles -> stop
+  double turn_check_angle = 0.3;     // rad: a turn on the spot is checked this far ahead
   double resume_clearance = 0.2;     // m: back off until this much is free again
   double backoff_speed = 0.1;        // m/s
   double max_backoff = 0.6;          // m
@@ -88,6 +89,8 @@ class Navigator {
   // The first point of the path ahead where base_link would come closer than blocked_clearance
   // to an obstacle perception added to the prior map; nullopt if none.
   std::optional<Eigen::Vector2d> PathAheadBlocked(const Pose2& estimate) const;
+  // "at (x y), seen obstacle at (x y)": the blocked point and the nearest cell perception added.
+  std::string DescribeBlock(const Eigen::Vector2d& blocked) const;
 
   const OccupancyGrid& map_;
   OccupancyGrid costmap_;  // the planner plans on this
