@@ -1,5 +1,7 @@
 #include "trimbot/garden/garden.h"
 
+#include <stdexcept>
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -146,6 +148,17 @@ std::string Garden::ToYaml() const {
     out << "}\n";
   }
   return out.str();
+}
+
+void Garden::AddObjects(const std::vector<GardenObject>& extra) {
+  for (const GardenObject& added : extra) {
+    for (const GardenObject& object : objects) {
+      if (object.id == added.id) {
+        throw std::invalid_argument("object id " + std::to_string(added.id) + " is already used in garden '" + name + "'");
+      }
+    }
+    objects.push_back(added);
+  }
 }
 
 std::string Garden::Resolve(const std::string& name_or_path, const std::string& gardens_dir) {

@@ -17,19 +17,11 @@ namespace trimbot::scenarios {
 
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
   garden::Garden surveyed = built;
-  for (std::size_t i = 0; i < survey.unmapped_objects.size(); ++i) {
-    const garden::GardenObject& extra = survey.unmapped_objects[i];
-    for (std::size_t j = 0; j < i; ++j) {
-      if (survey.unmapped_objects[j].id == extra.id) {
-        throw InputError(scenario_file, "survey.unmapped_objects: id " + std::to_string(extra.id) + " is used twice");
-      }
-    }
-    for (const garden::GardenObject& object : built.objects) {
-      if (object.id == extra.id) {
-        throw InputError(scenario_file, "survey.unmapped_objects: id " + std::to_string(extra.id) +
-                                            " is already an object of garden '" + built.name + "'");
-      }
-    }
+  try {
+    garden::Garden world = built;  // checked here, before any trial: placed by the simulator
+    world.AddObjects(survey.unmapped_objects);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(scenario_file, std::string("survey.unmapped_objects: ") + e.what());
   }
   for (int id : survey.unmapped) {
     const auto it = std::find_if(surveyed.objects.begin(), surveyed.objects.end(),
@@ -57,8 +49,7 @@ garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& path
 
 garden::OccupancyMap WorldMap(const Scenario& scenario, const ProjectPaths& paths) {
   garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
-  world.objects.insert(world.objects.end(), scenario.survey.unmapped_objects.begin(),
-                       scenario.survey.unmapped_objects.end());
+  world.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
   as_grown.growth = scenario.world.conditions.growth;
   return garden::MakeOccupancyMap(SurveyedGarden(world, as_grown, scenario.source), scenario.map_resolution,

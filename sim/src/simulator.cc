@@ -22,18 +22,13 @@ using robot::RobotFrames;
 
 namespace {
 
-// The garden file's objects plus the configuration's extra ones (ids must stay unique: labels and
-// contacts name objects by id).
+// The garden file's objects plus the configuration's extra ones.
 garden::Garden GardenWithExtraObjects(const SimulatorConfig& config) {
   garden::Garden garden = garden::Garden::Load(config.garden_path);
-  for (const garden::GardenObject& extra : config.extra_objects) {
-    for (const garden::GardenObject& object : garden.objects) {
-      if (object.id == extra.id) {
-        throw InputError(config.garden_path, "an extra object has id " + std::to_string(extra.id) +
-                                                 ", which the garden already uses");
-      }
-    }
-    garden.objects.push_back(extra);
+  try {
+    garden.AddObjects(config.extra_objects);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(config.garden_path, std::string("an extra object: ") + e.what());
   }
   return garden;
 }

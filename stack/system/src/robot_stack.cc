@@ -215,8 +215,8 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     for (int pair : PairsAhead()) {
       const robot::StereoPair& cameras =
           components_->obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)].pair();
-      ahead.cameras.push_back(std::min(cameras.left, cameras.right));
-      ahead.cameras.push_back(std::max(cameras.left, cameras.right));
+      ahead.cameras.push_back(cameras.left);
+      ahead.cameras.push_back(cameras.right);
     }
     std::sort(ahead.cameras.begin(), ahead.cameras.end());
     ahead.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size

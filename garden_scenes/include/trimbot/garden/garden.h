@@ -57,6 +57,9 @@ struct Garden {
   Surface SurfaceAt(const Eigen::Vector2d& point) const;
   // Finds garden_scenes/gardens/<name>.yaml, or takes a path to a .yaml file.
   static std::string Resolve(const std::string& name_or_path, const std::string& gardens_dir);
+  // Adds objects that are not in the garden file (a scenario's unmapped objects); ids must stay
+  // unique (labels and contacts name objects by id): std::invalid_argument naming the id otherwise.
+  void AddObjects(const std::vector<GardenObject>& extra);
 };
 
 bool IsFoliage(ObjectClass c);
