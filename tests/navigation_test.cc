@@ -10,7 +10,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <Eigen/Geometry>
+
 #include "trimbot/common/input_error.h"
+#include "trimbot/stack/bush_servo.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/navigator.h"
 #include "trimbot/stack/occupancy_grid.h"
@@ -262,6 +265,55 @@ TEST(Navigator, GoalNearAnObstacleIsReachedAtTheNearestFeasiblePoint) {
   const auto refused = DriveUntilDone(refusing, start, [](double, const Pose2&) {});
   EXPECT_EQ(refusing.mode(), Navigator::Mode::kFailed);
   EXPECT_EQ(Count(refused, NavigationEvent::Type::kGoalAdjusted), 0);
+}
+
+
+// The bush servo on a kinematic base: from 1.5 m off, with measurements of the bush's centre
+// every 0.4 s (1 cm noise), it stops with the arm's axis at the standoff, the bush straight ahead.
+TEST(BushServo, DrivesTheArmToTheStandoffAndConfirmsStandingStill) {
+  BushServoParameters parameters;
+  const Eigen::Vector2d arm_axis(0.23, 0.0), bush(3.0, 1.0);
+  BushServo servo(parameters, arm_axis);
+  Pose2 pose{1.6, 0.2, 0.3};  // the bush about 20 deg to the left
+  servo.Expect(bush + Eigen::Vector2d(0.1, -0.1), 0.35);  // the map's belief, 14 cm off
+  servo.Start(0.0);
+  std::uint64_t state = 12345;
+  const auto noise = [&state]() {  // deterministic, roughly uniform in [-1, 1]
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / static_cast<double>(1ULL << 52) - 1.0;
+  };
+  double t = 0.0;
+  for (; t < 60.0 && servo.mode() != BushServo::Mode::kDone; t += 0.05) {
+    if (std::fmod(t + 1e-9, 0.4) < 0.05) {
+      const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+      const Eigen::Vector2d d = bush - Eigen::Vector2d(pose.x, pose.y);
+      const Eigen::Vector2d in_base(c * d.x() + s * d.y() + 0.01 * noise(), -s * d.x() + c * d.y() + 0.01 * noise());
+      servo.AddMeasurement(t, pose, in_base);
+    }
+    const messages::BaseVelocityCommand command = servo.Update(t, pose);
+    pose.x += command.linear * std::cos(pose.yaw) * 0.05;
+    pose.y += command.linear * std::sin(pose.yaw) * 0.05;
+    pose.yaw += command.angular * 0.05;
+  }
+  ASSERT_EQ(servo.mode(), BushServo::Mode::kDone) << "not done after " << t << " s";
+  const Eigen::Vector2d arm = Eigen::Vector2d(pose.x, pose.y) + Eigen::Rotation2Dd(pose.yaw) * arm_axis;
+  const Eigen::Vector2d to_bush = Eigen::Rotation2Dd(-pose.yaw) * (bush - arm);
+  EXPECT_NEAR(to_bush.norm(), 0.35 + parameters.surface_gap, 0.01);
+  EXPECT_NEAR(std::atan2(to_bush.y(), to_bush.x()), 0.0, 1.0 * M_PI / 180.0);
+}
+
+TEST(BushServo, GivesUpWhenTheBushIsNotSeen) {
+  BushServo servo(BushServoParameters{}, {0.23, 0.0});
+  servo.Expect({2.0, 0.0}, 0.3);
+  servo.Start(0.0);
+  for (int k = 0; k <= BushServoParameters{}.max_lost_frames; ++k) servo.AddMiss(0.4 * k);
+  EXPECT_EQ(servo.mode(), BushServo::Mode::kFailed);
+  EXPECT_NE(servo.failure().find("bush lost"), std::string::npos) << servo.failure();
+  // A measurement far from the belief is not the bush.
+  BushServo other(BushServoParameters{}, {0.23, 0.0});
+  other.Expect({2.0, 0.0}, 0.3);
+  EXPECT_FALSE(other.AddMeasurement(0.0, Pose2{}, {2.0, 1.0}));
+  EXPECT_FALSE(other.tracking());
 }
 
 }  // namespace

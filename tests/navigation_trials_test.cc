@@ -54,7 +54,7 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
     EXPECT_EQ(s.name, name);
     EXPECT_EQ(s.goals.size(), 4u);
     EXPECT_EQ(s.trials, 6);
-    EXPECT_NEAR((s.goals.back() - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9) << "a loop";
+    EXPECT_NEAR((s.goals.back().position - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9) << "a loop";
     ASSERT_TRUE(s.stack.has_value());
     EXPECT_EQ(StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).localization,
               stack::LocalizationSource::kSimulatedPoseFixes);
@@ -71,7 +71,8 @@ TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const double radius = stack::PlannerParameters{}.robot_radius;
   Eigen::Vector2d from(s.world.start.x, s.world.start.y);
-  for (const auto& goal : s.goals) {
+  for (const auto& scenario_goal : s.goals) {
+    const Eigen::Vector2d goal = scenario_goal.position;
     EXPECT_GE(map.DistanceToObstacle(goal), radius) << "goal " << goal.transpose() << " is not reachable";
     double closest = 1e9;
     for (double f = 0.0; f <= 1.0; f += 0.005) closest = std::min(closest, map.DistanceToObstacle(from + f * (goal - from)));
@@ -163,6 +164,29 @@ TEST(Scenario, FixtureSettingsWithoutTheFixtureAreAnInputError) {
   const Scenario s = Scenario::Load(SmokeVariant("unused_fixes.yaml", "time_limit: 60.0",
                                                  "time_limit: 60.0\nsimulated_pose_fixes: {availability: 0.5}"));
   ExpectStackParametersError(s, "unused_fixes.yaml", "localization is 'none'");
+}
+
+// A bush goal names a bush of the garden as surveyed: an unknown id, or an object that is not a
+// bush (the test lawn's hedge), is refused naming the scenario and the goal.
+TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
+  for (const auto& [goal, problem] : std::vector<std::pair<std::string, std::string>>{
+           {"{approach_bush: 999}", "has no object 999"}, {"{approach_bush: 5}", "is a hedge, not a bush"}}) {
+    const Scenario s = Scenario::Load(SmokeVariant("bad_bush.yaml", "\\{x: 4.0, y: 0.0\\}", goal));
+    try {
+      MissionGoals(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+      ADD_FAILURE() << goal << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad_bush.yaml"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+    }
+  }
+  // A real bush gives the stack its surveyed centre and shape.
+  const Scenario ok = Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0\\}", "{approach_bush: 3}"));
+  const std::vector<stack::Goal> goals = MissionGoals(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  ASSERT_EQ(goals.size(), 1u);
+  ASSERT_TRUE(goals[0].bush.has_value());
+  EXPECT_EQ(goals[0].bush->kind, perception::BushShape::Kind::kCylinder);
+  EXPECT_NEAR((goals[0].position - Eigen::Vector2d(1.5, -2.2)).norm(), 0.0, 1e-12);
 }
 
 TEST(Scenario, BadFilesNameTheFileLineAndKey) {

@@ -25,15 +25,56 @@ std::string Tum(double t, const stack::Pose2& pose) { return TumLine(t, stack::T
 
 }  // namespace
 
-TrialEvaluator::TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance,
+TrialEvaluator::TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria,
                                double fix_history_seconds)
-    : goal_tolerance_(goal_tolerance), fix_history_seconds_(fix_history_seconds), goal_planned_(goals.size(), false) {
+    : truths_(goals), criteria_(criteria), fix_history_seconds_(fix_history_seconds), bush_status_(goals.size()),
+      goal_planned_(goals.size(), false) {
   for (const auto& goal : goals) {
     GoalResult result;
-    result.x = result.used_x = goal.x();
-    result.y = result.used_y = goal.y();
+    result.x = result.used_x = goal.position.x();
+    result.y = result.used_y = goal.position.y();
+    result.bush = goal.bush;
     goals_.push_back(result);
   }
+}
+
+Eigen::Vector2d TrialEvaluator::TrueBushDistanceBearing(const PlanarPose& truth, int goal) const {
+  const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
+  const Eigen::Vector2d d = truths_[static_cast<std::size_t>(goal)].position - Eigen::Vector2d(truth.x, truth.y);
+  const Eigen::Vector2d from_arm = Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y()) - criteria_.arm_axis;
+  return {from_arm.norm(), std::atan2(from_arm.y(), from_arm.x())};
+}
+
+void TrialEvaluator::ObserveBushSightings(const StepView& step) {
+  for (const stack::BushSighting& sighting : step.telemetry->bush_sightings) {
+    const PlanarPose* at = TruthAt(sighting.stamp);
+    if (at == nullptr || sighting.goal < 0 || sighting.goal >= static_cast<int>(truths_.size())) continue;
+    const Eigen::Vector2d truth = TrueBushDistanceBearing(*at, sighting.goal);
+    BushFrame frame;
+    frame.t = sighting.stamp;
+    frame.goal = sighting.goal;
+    frame.true_distance_m = truth.x();
+    frame.true_bearing_deg = truth.y() * 180.0 / M_PI;
+    frame.found = sighting.found;
+    if (sighting.found) {
+      frame.distance_error_m = sighting.distance - truth.x();
+      frame.bearing_error_deg = AngleDifference(sighting.bearing, truth.y()) * 180.0 / M_PI;
+    }
+    bush_frames_.push_back(frame);
+  }
+}
+
+void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const PlanarPose& truth, GoalResult* goal) const {
+  const std::optional<stack::BushApproachStatus>& status = bush_status_[static_cast<std::size_t>(event.goal)];
+  if (!status) return;  // the stack never reported approaching it: not reached
+  const Eigen::Vector2d actual = TrueBushDistanceBearing(truth, event.goal);
+  goal->bush_distance_error_m = actual.x() - status->target_distance;
+  goal->bush_bearing_error_deg = AngleDifference(actual.y(), status->target_bearing) * 180.0 / M_PI;
+  goal->bush_estimate_distance_error_m = status->distance - actual.x();
+  goal->bush_estimate_bearing_error_deg = AngleDifference(status->bearing, actual.y()) * 180.0 / M_PI;
+  goal->final_error_m = std::abs(goal->bush_distance_error_m);
+  goal->reached = std::abs(goal->bush_distance_error_m) <= criteria_.bush_distance &&
+                  std::abs(goal->bush_bearing_error_deg) <= criteria_.bush_bearing * 180.0 / M_PI;
 }
 
 TrialEvaluator::PlanarPose TrialEvaluator::Planar(double t, const Eigen::Isometry3d& pose) {
@@ -71,7 +112,12 @@ void TrialEvaluator::Observe(const StepView& step) {
   ObserveContacts(step);
   if (step.telemetry == nullptr) return;
   if (steps_ % std::lround(kEvaluationPeriod / step.timestep) == 0) Sample(step, truth);
+  ObserveBushSightings(step);
   ObserveEvents(step, truth);
+  // After the events: a bush goal is judged on the status the stack reported up to its arrival.
+  if (const auto& bush = step.telemetry->bush; bush && bush->goal >= 0 && bush->goal < static_cast<int>(bush_status_.size())) {
+    bush_status_[static_cast<std::size_t>(bush->goal)] = bush;
+  }
 }
 
 void TrialEvaluator::ObserveContacts(const StepView& step) {
@@ -136,12 +182,16 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
     if (event.type == Type::kGoalReached && known_goal) {
       // Judged where the robot meant to arrive: the asked goal, or where it moved it (reported).
       GoalResult& goal = goals_[event.goal];
-      goal.used_x = event.position.x();
+      goal.used_x = event.position.x();  // a bush goal: the bush's centre as the stack tracked it
       goal.used_y = event.position.y();
-      goal.adjusted_by_m = std::hypot(goal.used_x - goal.x, goal.used_y - goal.y);
       goal.arrival_time = step.time;
+      if (goal.bush != 0) {
+        JudgeBushGoal(event, truth, &goal);
+        continue;
+      }
+      goal.adjusted_by_m = std::hypot(goal.used_x - goal.x, goal.used_y - goal.y);
       goal.final_error_m = std::hypot(truth.x - goal.used_x, truth.y - goal.used_y);
-      goal.reached = goal.final_error_m <= goal_tolerance_;
+      goal.reached = goal.final_error_m <= criteria_.tolerance;
     }
   }
 }
@@ -169,6 +219,7 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   result->fixes_rejected = telemetry.localization.fixes_rejected;
   result->relocalizations = telemetry.localization.relocalizations;
   result->estimates = {ekf_, odometry_, fixes_};
+  result->bush_frames = bush_frames_;
   result->localization_rate = LocalizationRate();
   const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
   result->success = result->status == "completed" && all_reached && collisions_ == 0;
@@ -197,6 +248,15 @@ void TrialEvaluator::WriteFiles(const std::string& dir) const {
   WriteFileAtomically(dir + "/wheel_odometry.tum", odometry_tum_);
   WriteFileAtomically(dir + "/pose_fixes.tum", fixes_tum_);
   WriteFileAtomically(dir + "/events.csv", events_csv_);
+  if (!bush_frames_.empty()) {
+    std::ostringstream csv;
+    csv << "t,goal,true_distance_m,true_bearing_deg,found,distance_error_m,bearing_error_deg\n" << std::setprecision(6);
+    for (const BushFrame& f : bush_frames_) {
+      csv << f.t << ',' << f.goal << ',' << f.true_distance_m << ',' << f.true_bearing_deg << ',' << (f.found ? 1 : 0)
+          << ',' << f.distance_error_m << ',' << f.bearing_error_deg << '\n';
+    }
+    WriteFileAtomically(dir + "/bush_frames.csv", csv.str());
+  }
 }
 
 }  // namespace trimbot::scenarios

@@ -3,10 +3,13 @@
 // estimate errors (EKF, wheel odometry, pose fixes at their own stamps), path length, collisions
 // (contacts with garden objects), goals reached (judged on the ground truth when the stack says it
 // arrived), replans and recoveries from the stack's events. Writes ground_truth.tum, ekf.tum,
-// wheel_odometry.tum, pose_fixes.tum (TUM, usable with evo) and events.csv.
+// wheel_odometry.tum, pose_fixes.tum (TUM, usable with evo) and events.csv. Bush goals: the arm's
+// true distance and bearing to the bush's true centre at arrival against the stack's target and
+// its own estimate, and every frame the stack looked for the bush (bush_frames.csv).
 #include <Eigen/Core>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,10 +21,24 @@
 
 namespace trimbot::scenarios {
 
+// A goal as the evaluation judges it.
+struct GoalTruth {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's, or the bush's true centre
+  int bush = 0;                                          // garden object id; 0: a point goal
+};
+
+// When a goal counts as reached (ground truth at the robot's declared arrival).
+struct GoalCriteria {
+  double tolerance = 0.3;              // m from a point goal
+  double bush_distance = 0.03;         // m from the standoff the stack aimed at (arm's axis to the centre)
+  double bush_bearing = 3.0 * M_PI / 180.0;  // rad from the bearing it aimed at
+  Eigen::Vector2d arm_axis = Eigen::Vector2d::Zero();  // base_link: where bush distances are measured from
+};
+
 class TrialEvaluator : public Observer {
  public:
   // `fix_history_seconds`: how late a pose fix may arrive and still be judged at its stamp.
-  TrialEvaluator(const std::vector<Eigen::Vector2d>& goals, double goal_tolerance, double fix_history_seconds);
+  TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria, double fix_history_seconds);
 
   void Observe(const StepView& step) override;
   // Also measure the smallest clearance between the robot's footprint (circles of `circle_radius`
@@ -42,12 +59,19 @@ class TrialEvaluator : public Observer {
   const PlanarPose* TruthAt(double stamp) const;
   void ObserveEvents(const StepView& step, const PlanarPose& truth);
   void ObserveContacts(const StepView& step);
+  void ObserveBushSightings(const StepView& step);
+  // The arm's true distance (m) and bearing (rad) to goal `goal`'s bush, from the pose `truth`.
+  Eigen::Vector2d TrueBushDistanceBearing(const PlanarPose& truth, int goal) const;
+  void JudgeBushGoal(const stack::NavigationEvent& event, const PlanarPose& truth, GoalResult* goal) const;
   void Sample(const StepView& step, const PlanarPose& truth);
   double LocalizationRate() const;
 
-  double goal_tolerance_;
+  std::vector<GoalTruth> truths_;
+  GoalCriteria criteria_;
   double fix_history_seconds_;
   std::vector<GoalResult> goals_;
+  std::vector<std::optional<stack::BushApproachStatus>> bush_status_;  // per goal: the latest seen
+  std::vector<BushFrame> bush_frames_;
   EstimateErrors ekf_{"ekf", {}, {}}, odometry_{"wheel_odometry", {}, {}}, fixes_{"pose_fixes", {}, {}};
   std::string truth_tum_, ekf_tum_, odometry_tum_, fixes_tum_;
   std::string events_csv_ = "t,event,goal,detail\n";

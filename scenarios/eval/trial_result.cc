@@ -52,6 +52,13 @@ void to_json(nlohmann::json& j, const GoalResult& g) {
        {"adjusted_by_m", g.adjusted_by_m},
        {"used_x", g.used_x},
        {"used_y", g.used_y}};
+  if (g.bush != 0) {
+    j["bush"] = g.bush;
+    j["bush_distance_error_m"] = g.bush_distance_error_m;
+    j["bush_bearing_error_deg"] = g.bush_bearing_error_deg;
+    j["bush_estimate_distance_error_m"] = g.bush_estimate_distance_error_m;
+    j["bush_estimate_bearing_error_deg"] = g.bush_estimate_bearing_error_deg;
+  }
 }
 
 void from_json(const nlohmann::json& j, GoalResult& g) {
@@ -63,6 +70,26 @@ void from_json(const nlohmann::json& j, GoalResult& g) {
   g.adjusted_by_m = j.value("adjusted_by_m", 0.0);  // results written before goals could move
   g.used_x = j.value("used_x", g.x);
   g.used_y = j.value("used_y", g.y);
+  g.bush = j.value("bush", 0);
+  g.bush_distance_error_m = j.value("bush_distance_error_m", 0.0);
+  g.bush_bearing_error_deg = j.value("bush_bearing_error_deg", 0.0);
+  g.bush_estimate_distance_error_m = j.value("bush_estimate_distance_error_m", 0.0);
+  g.bush_estimate_bearing_error_deg = j.value("bush_estimate_bearing_error_deg", 0.0);
+}
+
+void to_json(nlohmann::json& j, const BushFrame& f) {
+  j = {{"t", f.t}, {"goal", f.goal}, {"true_distance_m", f.true_distance_m}, {"true_bearing_deg", f.true_bearing_deg},
+       {"found", f.found}, {"distance_error_m", f.distance_error_m}, {"bearing_error_deg", f.bearing_error_deg}};
+}
+
+void from_json(const nlohmann::json& j, BushFrame& f) {
+  j.at("t").get_to(f.t);
+  j.at("goal").get_to(f.goal);
+  j.at("true_distance_m").get_to(f.true_distance_m);
+  j.at("true_bearing_deg").get_to(f.true_bearing_deg);
+  j.at("found").get_to(f.found);
+  j.at("distance_error_m").get_to(f.distance_error_m);
+  j.at("bearing_error_deg").get_to(f.bearing_error_deg);
 }
 
 void to_json(nlohmann::json& j, const TrialResult& t) {
@@ -85,6 +112,7 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"faults", t.faults},
        {"estimates", t.estimates}};
   if (t.min_clearance_m) j["min_clearance_m"] = *t.min_clearance_m;
+  if (!t.bush_frames.empty()) j["bush_frames"] = t.bush_frames;
 }
 
 void from_json(const nlohmann::json& j, TrialResult& t) {
@@ -107,6 +135,7 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   j.at("faults").get_to(t.faults);
   j.at("estimates").get_to(t.estimates);
   if (j.contains("min_clearance_m")) t.min_clearance_m = j.at("min_clearance_m").get<double>();
+  if (j.contains("bush_frames")) j.at("bush_frames").get_to(t.bush_frames);
 }
 
 void to_json(nlohmann::json& j, const CriterionResult& c) {
@@ -128,6 +157,57 @@ void to_json(nlohmann::json& j, const BatchSummary& b) {
        {"metrics", b.metrics},
        {"trials", b.trials}};
 }
+
+namespace {
+
+// Metrics of the bush goals and of the frames at 1-3 m (see ComputeBatchMetrics).
+void AddBushMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
+  std::vector<double> distance, bearing, estimate_distance, estimate_bearing;
+  for (const TrialResult& trial : trials) {
+    for (const GoalResult& goal : trial.goals) {
+      if (goal.bush == 0 || goal.arrival_time < 0.0) continue;
+      distance.push_back(std::abs(goal.bush_distance_error_m));
+      bearing.push_back(std::abs(goal.bush_bearing_error_deg));
+      estimate_distance.push_back(std::abs(goal.bush_estimate_distance_error_m));
+      estimate_bearing.push_back(std::abs(goal.bush_estimate_bearing_error_deg));
+    }
+  }
+  const auto put = [&](const std::string& name, const std::vector<double>& samples) {
+    const ErrorStats stats = ErrorStats::From(samples);
+    metrics[name + "_mean"] = stats.mean;
+    metrics[name + "_max"] = stats.max;
+  };
+  if (!distance.empty()) {
+    metrics["bush_goals"] = static_cast<int>(distance.size());  // arrived at
+    put("bush_distance_error", distance);
+    put("bush_bearing_error", bearing);
+    put("bush_estimate_distance_error", estimate_distance);
+    put("bush_estimate_bearing_error", estimate_bearing);
+  }
+  std::vector<double> frame_distance, frame_bearing;
+  int frames = 0, within = 0;
+  for (const TrialResult& trial : trials) {
+    for (const BushFrame& frame : trial.bush_frames) {
+      if (frame.true_distance_m < 1.0 || frame.true_distance_m > 3.0) continue;
+      ++frames;
+      if (!frame.found) continue;
+      frame_distance.push_back(std::abs(frame.distance_error_m));
+      frame_bearing.push_back(std::abs(frame.bearing_error_deg));
+      within += std::abs(frame.distance_error_m) <= 0.05 && std::abs(frame.bearing_error_deg) <= 3.0 ? 1 : 0;
+    }
+  }
+  if (frames > 0) {
+    metrics["bush_frames_1_3m"] = frames;
+    metrics["bush_frame_found_rate"] = static_cast<double>(frame_distance.size()) / frames;
+    metrics["bush_frame_within_rate"] = static_cast<double>(within) / frames;
+    if (!frame_distance.empty()) {
+      put("bush_frame_distance_error", frame_distance);
+      put("bush_frame_bearing_error", frame_bearing);
+    }
+  }
+}
+
+}  // namespace
 
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned) {
   // Trials that never ran are missing from `trials` but still count in the rates' denominators.
@@ -186,6 +266,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
     metrics[name + "_heading_error_median_deg"] = heading.median;
     metrics[name + "_heading_error_max_deg"] = heading.max;
   }
+  AddBushMetrics(trials, metrics);
   return metrics;
 }
 

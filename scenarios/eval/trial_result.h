@@ -36,6 +36,24 @@ struct GoalResult {
   // at (within its goal_search_radius): arrival is judged there, and the move is reported.
   double adjusted_by_m = 0.0;     // 0: the goal as asked
   double used_x = 0.0, used_y = 0.0;  // the goal navigated to (as asked, or adjusted)
+  // A bush goal (approach_bush): the arm's axis at the robot's true pose against the bush's true
+  // centre when the robot declared arrival (reached: both errors within the bush tolerance).
+  int bush = 0;                             // garden object id; 0: a point goal
+  double bush_distance_error_m = 0.0;       // true distance - the standoff the stack aimed at
+  double bush_bearing_error_deg = 0.0;      // true bearing - the bearing it aimed at
+  double bush_estimate_distance_error_m = 0.0;   // the stack's tracked distance - the true one
+  double bush_estimate_bearing_error_deg = 0.0;  // the stack's tracked bearing - the true one
+};
+
+// One frame in which the stack looked for a bush: its estimate against the truth at the frame.
+struct BushFrame {
+  double t = 0.0;
+  int goal = 0;
+  double true_distance_m = 0.0;   // arm's axis to the bush's true centre
+  double true_bearing_deg = 0.0;
+  bool found = false;             // the stack's fit gave a centre (errors below are then set)
+  double distance_error_m = 0.0;  // estimated - true
+  double bearing_error_deg = 0.0;
 };
 
 struct TrialResult {
@@ -61,6 +79,7 @@ struct TrialResult {
   double localization_rate = -1.0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
+  std::vector<BushFrame> bush_frames;  // bush goals' sightings
 };
 
 // One pass criterion of the scenario, e.g. success_rate >= 1.0.
@@ -90,6 +109,8 @@ void to_json(nlohmann::json& j, const EstimateErrors& e);
 void from_json(const nlohmann::json& j, EstimateErrors& e);
 void to_json(nlohmann::json& j, const GoalResult& g);
 void from_json(const nlohmann::json& j, GoalResult& g);
+void to_json(nlohmann::json& j, const BushFrame& f);
+void from_json(const nlohmann::json& j, BushFrame& f);
 void to_json(nlohmann::json& j, const TrialResult& t);
 void from_json(const nlohmann::json& j, TrialResult& t);
 void to_json(nlohmann::json& j, const CriterionResult& c);
@@ -99,7 +120,11 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 // never ran counts as failed), goal_success_rate, trials_completed, collisions, recoveries,
 // mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), and per estimate E
 // (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
-// E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples).
+// E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples);
+// with bush goals: bush_goals, bush_{distance,bearing}_error_{mean,max} (final pose, absolute,
+// m / deg), bush_estimate_{distance,bearing}_error_{mean,max} (the stack's final estimate), and
+// over the frames at 1-3 m: bush_frames_1_3m, bush_frame_found_rate, bush_frame_{distance,
+// bearing}_error_{mean,max}, bush_frame_within_rate (within 5 cm and 3 deg).
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);
 
 }  // namespace trimbot::scenarios

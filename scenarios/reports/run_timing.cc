@@ -40,6 +40,7 @@ RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim
         {"visual_other", "stack", visual_rest, frames, "localized frame"},
         {"stereo_fusion", "stack", stack->perception, 0, ""},
         {"obstacles", "stack", stack->obstacles, stack->obstacle_pairs, "stereo pair"},
+        {"bush_approach", "stack", stack->bush, stack->bush_frames, "bush frame"},
         {"planning", "stack", stack->planning, 0, ""},
         {"control", "stack", stack->control, 0, ""}};
     t.stages.insert(t.stages.end(), stack_stages.begin(), stack_stages.end());

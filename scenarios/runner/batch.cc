@@ -20,6 +20,7 @@
 #include <sstream>
 #include <thread>
 
+#include "reports/bush_plot.h"
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
@@ -163,8 +164,9 @@ std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<T
 }
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.
+// `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
 int WriteReports(const std::string& out, const Scenario& scenario, const garden::OccupancyMap& map,
-                 const garden::OccupancyMap& world, const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
+                 const garden::OccupancyMap& world, const std::vector<Eigen::Vector2d>& goals, const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   BatchSummary summary;
   summary.scenario = scenario.name;
@@ -196,9 +198,11 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
     if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
     trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
   }
-  WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, scenario.goals,
+  WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, goals,
                       scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
   WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
+  WriteBushFramePlot(out + "/bush_frames.png", scenario.name + ": the bush from stereo per frame", results);
+  WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth", results);
 
   log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
   for (const auto& r : results) log << "  " << OneLine(r) << "\n";
@@ -208,7 +212,7 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
               << " (actual " << c.actual << ")\n";
   }
   if (timing) log << "summed over the trials' processes, " << FormatRunTiming(*timing);
-  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, trajectories.png, localization_errors.png)\n";
+  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n";
   return summary.pass ? 0 : 1;
 }
 
@@ -286,7 +290,9 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
 
 // The result of a trial process that has ended (or was killed for its wall-clock limit), else
 // nullopt while it runs.
-std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& scenario) {
+// `goals`: where the goals truly are (a crashed trial's result lists them unreached).
+std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& scenario,
+                                     const std::vector<Eigen::Vector2d>& goals) {
   int status = 0;
   const pid_t done = waitpid(trial.pid, &status, WNOHANG);
   const double wall = std::chrono::duration<double>(Clock::now() - trial.started).count();
@@ -313,7 +319,13 @@ std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& 
   if (!result) return std::nullopt;
   result->wall_seconds = wall;
   if (result->goals.empty()) {
-    for (const auto& goal : scenario.goals) result->goals.push_back({goal.x(), goal.y()});
+    for (std::size_t i = 0; i < goals.size(); ++i) {
+      GoalResult goal;
+      goal.x = goal.used_x = goals[i].x();
+      goal.y = goal.used_y = goals[i].y();
+      goal.bush = scenario.goals[i].bush;
+      result->goals.push_back(goal);
+    }
   }
   if (result->status == "crashed" || result->status == "timeout") {
     WriteFileAtomically(trial.dir + "/result.json", json(*result).dump(2));
@@ -341,6 +353,8 @@ int RunBatch(const BatchOptions& options) {
   const Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
   StackParametersFor(scenario, options.paths);
   const garden::OccupancyMap map = PriorMap(scenario, options.paths);
+  const std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
+  const std::vector<Eigen::Vector2d> true_goals = TrueGoalPositions(scenario, options.paths);
   const std::string& out = options.out_dir;
   BatchInfo info;
   info.scenario_file = fs::absolute(options.scenario_path).string();
@@ -389,7 +403,7 @@ int RunBatch(const BatchOptions& options) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     for (auto it = running.begin(); it != running.end();) {
-      std::optional<TrialResult> result = PollTrial(*it, scenario);
+      std::optional<TrialResult> result = PollTrial(*it, scenario, true_goals);
       if (!result) {
         ++it;
         continue;
@@ -403,7 +417,7 @@ int RunBatch(const BatchOptions& options) {
     }
     if (interactive && !running.empty()) PrintProgress(running, results.size(), planned, scenario, batch_start);
   }
-  return WriteReports(out, scenario, map, WorldMap(scenario, options.paths), info, results, planned, log);
+  return WriteReports(out, scenario, map, WorldMap(scenario, options.paths), planned_goals, info, results, planned, log);
 }
 
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths) {
@@ -447,7 +461,8 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
               << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
-  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths), merged, found,
+  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
+                      GoalPositions(MissionGoals(scenario, paths)), merged, found,
                       merged.trials, std::cout);
 }
 

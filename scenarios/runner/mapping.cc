@@ -126,7 +126,7 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   drive->robot = std::make_unique<stack::RobotStack>(options.paths.robot_files(), parameters, drive->world.seed);
   drive->robot->SetInitialPose(0.0, {scenario.world.start.x, scenario.world.start.y, scenario.world.start.yaw});
   drive->robot->SetMap(WritePriorMap(PriorMap(scenario, options.paths), options.out_dir + "/prior_map"));
-  drive->robot->SetGoals(scenario.goals);
+  drive->robot->SetGoals(MissionGoals(scenario, options.paths));
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     drive->fixes.emplace(scenario.simulated_pose_fixes, drive->world.seed);
   }

@@ -61,6 +61,65 @@ std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& di
   return dir + "/map.yaml";
 }
 
+namespace {
+
+const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const Scenario& scenario) {
+  const auto it = std::find_if(garden.objects.begin(), garden.objects.end(),
+                               [id](const garden::GardenObject& o) { return o.id == id; });
+  if (it == garden.objects.end()) {
+    throw InputError(scenario.source, "goals: approach_bush " + std::to_string(id) + ": the garden '" + garden.name +
+                                          "' as surveyed has no object " + std::to_string(id));
+  }
+  if (it->object_class != garden::ObjectClass::kTopiary && it->object_class != garden::ObjectClass::kRose) {
+    throw InputError(scenario.source, "goals: approach_bush " + std::to_string(id) + ": object " + std::to_string(id) +
+                                          " is a " + garden::ToString(it->object_class) + ", not a bush (topiary or rose)");
+  }
+  return *it;
+}
+
+perception::BushShape ShapeOf(const garden::GardenObject& object) {
+  perception::BushShape shape;
+  shape.kind = object.shape == garden::Shape::kEllipsoid ? perception::BushShape::Kind::kEllipsoid
+               : object.shape == garden::Shape::kCylinder ? perception::BushShape::Kind::kCylinder
+                                                          : perception::BushShape::Kind::kBox;
+  shape.size = object.size;
+  shape.base_height = object.base_height;
+  shape.yaw = object.yaw;
+  return shape;
+}
+
+}  // namespace
+
+std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPaths& paths) {
+  const garden::Garden built = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden surveyed = SurveyedGarden(built, scenario.survey, scenario.source);
+  std::vector<stack::Goal> goals;
+  for (const ScenarioGoal& goal : scenario.goals) {
+    if (goal.bush == 0) {
+      goals.emplace_back(goal.position);
+      continue;
+    }
+    const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario);
+    goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
+  }
+  return goals;
+}
+
+std::vector<Eigen::Vector2d> TrueGoalPositions(const Scenario& scenario, const ProjectPaths& paths) {
+  const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  std::vector<Eigen::Vector2d> positions;
+  for (const ScenarioGoal& goal : scenario.goals) {
+    positions.push_back(goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario).position);
+  }
+  return positions;
+}
+
+std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals) {
+  std::vector<Eigen::Vector2d> positions;
+  for (const stack::Goal& goal : goals) positions.push_back(goal.position);
+  return positions;
+}
+
 stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
   Rng rng = MakeRng(seed, "initial_pose");
   std::normal_distribution<double> normal(0.0, 1.0);

@@ -6,6 +6,7 @@
 // the scenario's `stack:` overrides). The simulator never sees any of these.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "runner/scenario.h"
 #include "runner/world_setup.h"
@@ -26,6 +27,16 @@ garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& path
 garden::OccupancyMap WorldMap(const Scenario& scenario, const ProjectPaths& paths);
 // Writes it (map_server) as <dir>/map.{png,yaml}; returns the YAML's path.
 std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir);
+
+// The mission as the stack gets it: point goals as given; bush goals with the bush as surveyed
+// (centre, shape, yaw). Throws InputError naming the scenario for a bush the surveyed garden lacks
+// or an object that is not a bush (topiary or rose).
+std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPaths& paths);
+// Where each goal truly is, for the evaluation: a point goal's position, a bush's true centre in
+// the world (the garden file's object).
+std::vector<Eigen::Vector2d> TrueGoalPositions(const Scenario& scenario, const ProjectPaths& paths);
+// The goals' positions as planned (a bush goal: its surveyed centre), for plots.
+std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals);
 
 // Where the operator believes the robot stands: the true start with seeded placement error.
 stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed);

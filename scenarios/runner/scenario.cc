@@ -101,11 +101,24 @@ void ReadMission(const YamlMap& root, Scenario& s) {
   }
   if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"));
   for (const YamlMap& goal : root.MapList("goals")) {
-    s.goals.emplace_back(goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m"));
+    ScenarioGoal g;
+    if (goal.Has("approach_bush")) {
+      g.bush = goal.Integer("approach_bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
+    } else {
+      g.position = {goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m")};
+    }
     goal.RejectUnknownKeys();
+    s.goals.push_back(g);
   }
   if (s.goals.empty()) root.Fail("goals", "needs at least one goal");
   s.goal_tolerance = root.NumberOr("goal_tolerance", s.goal_tolerance, 1e-3, 10.0, "m");
+  if (root.Has("bush_tolerance")) {
+    const YamlMap tolerance = root.Map("bush_tolerance");
+    s.bush_distance_tolerance = tolerance.NumberOr("distance", s.bush_distance_tolerance, 1e-4, 10.0, "m");
+    s.bush_bearing_tolerance =
+        tolerance.NumberOr("bearing_deg", s.bush_bearing_tolerance * 180.0 / M_PI, 1e-3, 180.0, "deg") * M_PI / 180.0;
+    tolerance.RejectUnknownKeys();
+  }
   if (root.Has("initial_pose_sigma")) {
     const YamlMap sigma = root.Map("initial_pose_sigma");
     s.initial_position_sigma = sigma.NumberOr("position", s.initial_position_sigma, 0.0, 10.0, "m");
@@ -165,6 +178,12 @@ bool IsKnownMetric(const std::string& name) {
     std::set<std::string> names = {"success_rate", "goal_success_rate", "trials_completed", "collisions",
                                    "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate",
                                    "min_clearance_m"};
+    names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
+    for (const char* bush : {"bush_distance_error", "bush_bearing_error", "bush_estimate_distance_error",
+                             "bush_estimate_bearing_error", "bush_frame_distance_error", "bush_frame_bearing_error"}) {
+      names.insert(std::string(bush) + "_mean");
+      names.insert(std::string(bush) + "_max");
+    }
     for (const char* estimate : {"ekf", "wheel_odometry", "pose_fixes"}) {
       for (const char* stat : {"mean", "median", "max", "rmse"}) {
         names.insert(std::string(estimate) + "_position_error_" + stat + "_m");

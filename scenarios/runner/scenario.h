@@ -46,6 +46,13 @@ struct CalibrationError {
   bool any() const { return focal_relative > 0 || principal_point_px > 0 || rotation_deg > 0 || translation_m > 0; }
 };
 
+// A goal of the mission: a point in the map frame, or a bush of the garden to approach for
+// trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff).
+struct ScenarioGoal {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's (a bush's: see MissionGoals)
+  int bush = 0;                                          // the garden object's id; 0: a point goal
+};
+
 struct Scenario {
   std::string source;       // file it was read from
   std::string name;
@@ -54,8 +61,12 @@ struct Scenario {
   double map_resolution = 0.05;        // m: the robot's prior map, made from the surveyed garden
   double map_clearance_height = 1.0;   // m: objects whose lowest point is higher are not obstacles
   Survey survey;
-  std::vector<Eigen::Vector2d> goals;  // map frame, in order
+  std::vector<ScenarioGoal> goals;     // in order
   double goal_tolerance = 0.3;         // m: a goal counts as reached within this (ground truth)
+  // A bush goal counts as reached when the arm's axis stands within these of the standoff
+  // distance and bearing the stack aimed at (ground truth).
+  double bush_distance_tolerance = 0.03;               // m
+  double bush_bearing_tolerance = 3.0 * M_PI / 180.0;  // rad
   double initial_position_sigma = 0.1; // m per axis: the stack's start belief = truth + this noise
   double initial_yaw_sigma = 3.0 * M_PI / 180.0;  // rad
   CalibrationError calibration_error;

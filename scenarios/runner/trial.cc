@@ -72,18 +72,28 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
   const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
-  sim::Simulator simulator(PlantFor(setup, parameters.UsesRingImages()));
+  const std::vector<stack::Goal> mission = MissionGoals(scenario, setup.paths);
+  const bool uses_images = stack::RobotStack::UsesRingImages(parameters, mission);
+  sim::Simulator simulator(PlantFor(setup, uses_images));
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
   robot.SetMap(setup.map_yaml);
   if (visual) robot.SetVisualMap(scenario.visual_map);
-  robot.SetGoals(scenario.goals);
+  robot.SetGoals(mission);
 
   std::optional<SimulatedPoseFixes> fixes;
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     fixes.emplace(scenario.simulated_pose_fixes, setup.seed);
   }
-  TrialEvaluator evaluator(scenario.goals, scenario.goal_tolerance,
+  std::vector<GoalTruth> goals;
+  const std::vector<Eigen::Vector2d> true_positions = TrueGoalPositions(scenario, setup.paths);
+  for (std::size_t i = 0; i < true_positions.size(); ++i) goals.push_back({true_positions[i], scenario.goals[i].bush});
+  GoalCriteria criteria;
+  criteria.tolerance = scenario.goal_tolerance;
+  criteria.bush_distance = scenario.bush_distance_tolerance;
+  criteria.bush_bearing = scenario.bush_bearing_tolerance;
+  criteria.arm_axis = simulator.robot().FramePose(robot::RobotFrames::kCameraRing).translation().head<2>();
+  TrialEvaluator evaluator(goals, criteria,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
   const stack::Footprint& footprint = parameters.navigation.planner.footprint;
   evaluator.MeasureClearance(WorldMap(scenario, setup.paths), footprint.circle_x, footprint.circle_radius);
@@ -91,7 +101,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   LoopOptions options;
   options.time_limit = scenario.time_limit;
   options.pose_fixes = fixes ? &*fixes : nullptr;
-  options.render_on_demand = parameters.UsesRingImages();
+  options.render_on_demand = uses_images;
   options.progress = progress;
   const auto loop_start = std::chrono::steady_clock::now();
   const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);

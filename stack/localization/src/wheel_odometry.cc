@@ -25,4 +25,22 @@ void WheelOdometry::Update(const messages::WheelTicks& ticks) {
   last_ = ticks;
 }
 
+void GyroOdometry::AddYawRate(double stamp, double yaw_rate) {
+  if (last_gyro_stamp_ >= 0.0 && stamp > last_gyro_stamp_) {
+    pose_.yaw = std::remainder(pose_.yaw + yaw_rate * (stamp - last_gyro_stamp_), 2.0 * M_PI);
+  }
+  last_gyro_stamp_ = stamp;
+}
+
+void GyroOdometry::AddWheelTicks(const messages::WheelTicks& ticks) {
+  const Pose2 before = wheels_.pose();
+  wheels_.Update(ticks);
+  const double distance = std::hypot(wheels_.pose().x - before.x, wheels_.pose().y - before.y);
+  const double direction = wheels_.linear_velocity() < 0.0 ? -1.0 : 1.0;
+  const double heading = heading_at_ticks_ + 0.5 * std::remainder(pose_.yaw - heading_at_ticks_, 2.0 * M_PI);
+  pose_.x += direction * distance * std::cos(heading);
+  pose_.y += direction * distance * std::sin(heading);
+  heading_at_ticks_ = pose_.yaw;
+}
+
 }  // namespace trimbot::stack

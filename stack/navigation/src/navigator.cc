@@ -22,6 +22,7 @@ const char* ToString(NavigationEvent::Type type) {
     case NavigationEvent::Type::kRecovered: return "recovered";
     case NavigationEvent::Type::kPathBlocked: return "path_blocked";
     case NavigationEvent::Type::kGoalAdjusted: return "goal_adjusted";
+    case NavigationEvent::Type::kApproachReached: return "approach_reached";
   }
   return "?";
 }
@@ -72,9 +73,10 @@ std::optional<Eigen::Vector2d> Navigator::PathAheadBlocked(const Pose2& estimate
   return std::nullopt;
 }
 
-void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
+void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals, int first_index) {
   goals_ = goals;
   goal_ = 0;
+  first_index_ = first_index;
   recoveries_ = 0;
   plan_failures_ = 0;
   follower_.SetPath({});
@@ -87,7 +89,7 @@ double Navigator::FootprintClearance(const Pose2& pose) const {
 
 void Navigator::Emit(double stamp, NavigationEvent::Type type, const std::string& detail,
                      const Eigen::Vector2d& position) {
-  events_.push_back({stamp, type, goal_, detail, position});
+  events_.push_back({stamp, type, first_index_ + goal_, detail, position});
 }
 
 std::vector<NavigationEvent> Navigator::TakeEvents() {

@@ -12,6 +12,7 @@
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
 #include "trimbot/robot/robot_parameters.h"
+#include "trimbot/stack/bush_servo.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/navigator.h"
@@ -38,6 +39,17 @@ class ScopedTimer {
   double* total_;
   Clock::time_point start_;
 };
+
+// The frame holds camera `camera`'s image (a driver delivers only what was asked for, and cameras drop out).
+bool Delivered(const messages::RingFrame& frame, int camera) {
+  return std::any_of(frame.images.begin(), frame.images.end(),
+                     [camera](const messages::Image& image) { return image.camera_index == camera; });
+}
+
+// A planar point through a (planar) transform.
+Eigen::Vector2d Apply(const Eigen::Isometry3d& T, const Eigen::Vector2d& p) {
+  return (T * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>();
+}
 
 MissionState ToMission(Navigator::Mode mode) {
   switch (mode) {
@@ -67,6 +79,7 @@ struct RobotStack::Components {
   robot::CameraRig rig;
   int ticks_per_revolution = 0;
   WheelOdometry odometry;
+  GyroOdometry servo_odometry;                    // the bush servo's frame
   Ekf ekf;
   Pose2 odom_origin;                              // map pose of the odom frame
   std::unique_ptr<OccupancyGrid> map;
@@ -75,6 +88,9 @@ struct RobotStack::Components {
   std::unique_ptr<perception::RingStereo> obstacle_stereo;  // with obstacle detection on
   std::unique_ptr<ObstacleLayer> obstacle_layer;            // made with the map
   std::unique_ptr<visual_localization::VisualLocalizer> localizer;
+  Eigen::Vector2d arm_axis;                                 // base_link: the arm's base (the ring's centre)
+  std::unique_ptr<perception::RingStereo> bush_stereo;      // made with a mission that has bush goals
+  BushServo servo;
   Rng latency_rng;
 
   Components(const robot::RobotFiles& files, const StackParameters& parameters)
@@ -83,7 +99,10 @@ struct RobotStack::Components {
                                          description.FramePose(robot::RobotFrames::CameraOptical(0)))),
         ticks_per_revolution(robot::RobotParameters::Load(files.robot_parameters).wheel_encoders.ticks_per_revolution),
         odometry(description.drive(), ticks_per_revolution),
+        servo_odometry(description.drive(), ticks_per_revolution),
         ekf(parameters.ekf, description.drive(), ticks_per_revolution),
+        arm_axis(description.FramePose(robot::RobotFrames::kCameraRing).translation().head<2>()),
+        servo(parameters.bush_approach.servo, arm_axis),
         latency_rng(0) {
     if (parameters.local_fusion.enabled) fusion = std::make_unique<perception::LocalFusion>(rig, parameters.local_fusion);
     if (parameters.obstacles.enabled) {
@@ -119,6 +138,15 @@ RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& pa
     throw std::invalid_argument("stack parameters: perception.obstacles.max_bearing_deg leaves no stereo pair "
                                 "facing forward");
   }
+  // The standoff must leave the footprint's front clear of the bush's surveyed outline.
+  const Footprint& footprint = parameters_.navigation.planner.footprint;
+  const double front = *std::max_element(footprint.circle_x.begin(), footprint.circle_x.end()) +
+                       footprint.circle_radius - components_->arm_axis.x();
+  if (parameters_.bush_approach.servo.surface_gap < front + parameters_.navigation.stop_clearance) {
+    throw std::invalid_argument("stack parameters: bush_approach.servo.surface_gap must be at least " +
+                                std::to_string(front + parameters_.navigation.stop_clearance) +
+                                " m (the footprint's front from the arm's axis, plus navigation.stop_clearance)");
+  }
   components_->latency_rng = MakeRng(seed, "visual_localization_latency");
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
@@ -153,13 +181,92 @@ void RobotStack::SetVisualMap(const std::string& map_path) {
   components_->localizer = MakeVisualLocalizer(map_path, parameters_.visual, components_->rig);
 }
 
-void RobotStack::SetGoals(const std::vector<Eigen::Vector2d>& goals) {
+Goal Goal::ApproachBush(const Eigen::Vector2d& centre, const perception::BushShape& shape) {
+  Goal goal(centre);
+  goal.bush = shape;
+  return goal;
+}
+
+bool RobotStack::UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals) {
+  return parameters.UsesRingImages() ||
+         std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
+}
+
+void RobotStack::SetGoals(const std::vector<Goal>& goals) {
   if (!components_->navigator) throw std::logic_error("RobotStack::SetGoals: no map (call SetMap first)");
   if (parameters_.localization == LocalizationSource::kVisual && !components_->localizer) {
     throw std::logic_error("RobotStack::SetGoals: localization is visual but no visual map was given (SetVisualMap)");
   }
-  components_->navigator->SetGoals(goals);
+  mission_ = goals;
+  next_goal_ = 0;
+  mission_failed_ = false;
+  const bool bushes = std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
+  if (bushes && !components_->bush_stereo) {
+    components_->bush_stereo = std::make_unique<perception::RingStereo>(components_->rig, perception::StereoOptions{});
+  }
+  StartSegment();
   teleop_.reset();
+}
+
+Eigen::Vector2d RobotStack::ApproachPoint(const Goal& goal, const Eigen::Vector2d& from) const {
+  // base_link's position from which, turned to face the bush, the arm's axis is approach_margin
+  // beyond the standoff. Of the sides of the bush (every 10 deg) where the footprint at the
+  // standoff clears the map (other than the bush), the nearest to where the robot comes from whose
+  // approach point can be arrived at from any direction (RRT* reaches a goal only along an edge
+  // from its nearest node, so a goal some headings cannot arrive at makes it fail at random);
+  // failing that, one the planner accepts at all.
+  const Components& c = *components_;
+  const Navigator& navigator = *c.navigator;
+  const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
+  const double reach = standoff + parameters_.bush_approach.approach_margin + c.arm_axis.x();
+  for (const double clearance : {navigator.ArrivalClearance(), parameters_.navigation.planner.robot_radius}) {
+    std::optional<Eigen::Vector2d> best;
+    for (int k = 0; k < 36; ++k) {
+      const double angle = 2.0 * M_PI * k / 36.0;
+      const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
+      const Eigen::Vector2d approach = goal.position + reach * side;
+      const Eigen::Vector2d at_standoff = goal.position + (standoff + c.arm_axis.x()) * side;
+      const Pose2 facing{at_standoff.x(), at_standoff.y(), angle + M_PI};
+      if (navigator.costmap().DistanceToObstacle(approach) < clearance ||
+          navigator.FootprintClearance(facing) < 2.0 * parameters_.navigation.stop_clearance) {
+        continue;
+      }
+      if (!best || (approach - from).norm() < (*best - from).norm()) best = approach;
+    }
+    if (best) return *best;
+  }
+  // No side is free: straight from where the robot comes (the navigator moves the point or says why).
+  const Eigen::Vector2d away = (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized()
+                                                                      : Eigen::Vector2d(-1.0, 0.0);
+  return goal.position + reach * away;
+}
+
+void RobotStack::StartSegment() {
+  Components& c = *components_;
+  const Pose2 estimate = c.ekf.Estimate().pose;
+  Eigen::Vector2d from(estimate.x, estimate.y);
+  std::vector<Eigen::Vector2d> points;
+  bush_goal_ = -1;
+  servoing_ = false;
+  for (int i = next_goal_; i < static_cast<int>(mission_.size()); ++i) {
+    const Goal& goal = mission_[static_cast<std::size_t>(i)];
+    if (goal.bush) {
+      points.push_back(ApproachPoint(goal, from));
+      bush_goal_ = i;
+      break;
+    }
+    points.push_back(goal.position);
+    from = goal.position;
+  }
+  c.navigator->SetGoals(points, next_goal_);
+  if (bush_goal_ >= 0) {
+    const Goal& goal = mission_[static_cast<std::size_t>(bush_goal_)];
+    c.servo.Expect(Apply(MapFromServoFrame().inverse(), goal.position), goal.bush->Radius());
+    bush_status_ = BushApproachStatus{};
+    bush_status_.goal = bush_goal_;
+    bush_status_.target_distance = c.servo.target_distance();
+    bush_status_.target_bearing = parameters_.bush_approach.servo.bearing;
+  }
 }
 
 void RobotStack::SetTeleopCommand(const messages::BaseVelocityCommand& command) { teleop_ = command; }
@@ -167,12 +274,16 @@ void RobotStack::SetTeleopCommand(const messages::BaseVelocityCommand& command) 
 void RobotStack::Add(const messages::ImuSample& imu) {
   ScopedTimer timer(&telemetry_.timings.ekf);
   components_->ekf.AddImu(imu);
+  if (components_->ekf.initialized()) {
+    components_->servo_odometry.AddYawRate(imu.stamp, imu.angular_velocity.z() - components_->ekf.Estimate().gyro_bias);
+  }
 }
 
 void RobotStack::Add(const messages::WheelTicks& ticks) {
   ScopedTimer timer(&telemetry_.timings.ekf);
   components_->ekf.AddWheelTicks(ticks);
   components_->odometry.Update(ticks);
+  components_->servo_odometry.AddWheelTicks(ticks);
 }
 
 void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
@@ -183,6 +294,7 @@ void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
   if (VisualLocalizationDue(frame.stamp)) LocalizeVisually(frame);
   if (ObstacleDetectionDue(frame.stamp)) DetectObstacles(frame);
+  if (BushSightingDue(frame.stamp)) LookForBush(frame);
   if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
     ScopedTimer timer(&telemetry_.timings.perception);
     // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
@@ -222,6 +334,14 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     ahead.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
     request = messages::Merge(request, ahead);
   }
+  if (BushSightingDue(stamp)) {
+    const robot::StereoPair cameras =
+        components_->bush_stereo->rectifiers()[static_cast<std::size_t>(*PairFacingBush())].pair();
+    messages::RingRequest bush;
+    bush.cameras = {std::min(cameras.left, cameras.right), std::max(cameras.left, cameras.right)};
+    bush.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
+    request = messages::Merge(request, bush);
+  }
   if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
     messages::RingRequest stereo;
     for (int i = 0; i < components_->rig.size(); ++i) stereo.cameras.push_back(i);
@@ -254,10 +374,6 @@ void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
   ScopedTimer timer(&telemetry_.timings.obstacles);
   Components& c = *components_;
   next_obstacle_frame_ = frame.stamp + 1.0 / parameters_.obstacles.rate_hz;
-  const auto has = [&](int camera) {
-    return std::any_of(frame.images.begin(), frame.images.end(),
-                       [camera](const messages::Image& image) { return image.camera_index == camera; });
-  };
   const Eigen::Isometry3d T_map_base = ToIsometry(c.ekf.Estimate().pose);
   perception::ObstaclePointOptions options = parameters_.obstacles.points;
   // The robot's own body (base, ring, arm at rest) is the footprint's box with a margin.
@@ -271,7 +387,7 @@ void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
   observation.min_obstacle_height = options.min_height;
   for (int pair : PairsAhead()) {
     const perception::StereoRectifier& rectifier = c.obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)];
-    if (!has(rectifier.pair().left) || !has(rectifier.pair().right)) continue;  // not delivered
+    if (!Delivered(frame, rectifier.pair().left) || !Delivered(frame, rectifier.pair().right)) continue;
     const perception::RingStereo::PairResult result = c.obstacle_stereo->ComputePair(frame, pair);
     const perception::ObstaclePoints points =
         perception::FindObstaclePoints(result.cloud, rectifier.T_base_rectified_left().translation(), options);
@@ -293,6 +409,84 @@ void RobotStack::DetectObstacles(const messages::RingFrame& frame) {
     c.navigator->SetCostmap(c.obstacle_layer->MergedWith(*c.map));
     ++telemetry_.obstacles.costmap_updates;
   }
+}
+
+Eigen::Isometry3d RobotStack::MapFromServoFrame() const {
+  // The EKF's map pose of base_link and the gyro odometry's pose of it, at the same time.
+  return ToIsometry(components_->ekf.Estimate().pose) * ToIsometry(components_->servo_odometry.pose()).inverse();
+}
+
+Eigen::Vector2d RobotStack::ExpectedBushInBase() const {
+  const Components& c = *components_;
+  const Eigen::Isometry3d T_base_odom = ToIsometry(c.servo_odometry.pose()).inverse();
+  if (c.servo.tracking()) return Apply(T_base_odom, c.servo.centre());
+  const Eigen::Isometry3d T_base_map = ToIsometry(c.ekf.Estimate().pose).inverse();
+  return Apply(T_base_map, mission_[static_cast<std::size_t>(bush_goal_)].position);
+}
+
+std::optional<int> RobotStack::PairFacingBush() const {
+  if (bush_goal_ < 0 || !components_->bush_stereo) return std::nullopt;
+  const Eigen::Vector2d bush = ExpectedBushInBase();
+  if ((bush - components_->arm_axis).norm() > parameters_.bush_approach.sighting_range) return std::nullopt;
+  std::optional<int> best;
+  double best_angle = parameters_.bush_approach.max_bearing;
+  const auto& rectifiers = components_->bush_stereo->rectifiers();
+  for (std::size_t i = 0; i < rectifiers.size(); ++i) {
+    const Eigen::Isometry3d& T = rectifiers[i].T_base_rectified_left();
+    const Eigen::Vector2d axis = T.linear().col(2).head<2>(), to_bush = bush - T.translation().head<2>();
+    const double angle = std::abs(std::remainder(std::atan2(to_bush.y(), to_bush.x()) - std::atan2(axis.y(), axis.x()),
+                                                 2.0 * M_PI));
+    if (angle <= best_angle) {
+      best_angle = angle;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+bool RobotStack::BushSightingDue(double stamp) const {
+  return bush_goal_ >= 0 && stamp + 1e-9 >= next_bush_frame_ && PairFacingBush().has_value();
+}
+
+void RobotStack::LookForBush(const messages::RingFrame& frame) {
+  ScopedTimer timer(&telemetry_.timings.bush);
+  Components& c = *components_;
+  const int pair = *PairFacingBush();
+  const perception::StereoRectifier& rectifier = c.bush_stereo->rectifiers()[static_cast<std::size_t>(pair)];
+  if (!Delivered(frame, rectifier.pair().left) || !Delivered(frame, rectifier.pair().right)) return;
+  next_bush_frame_ = frame.stamp + 1.0 / parameters_.bush_approach.rate_hz;
+  ++telemetry_.timings.bush_frames;
+  BushSighting sighting;
+  sighting.stamp = frame.stamp;
+  sighting.goal = bush_goal_;
+  const Goal& goal = mission_[static_cast<std::size_t>(bush_goal_)];
+  if (!c.servo.tracking()) {
+    // The map's belief through the pose estimate now (odometry's heading drifts in turns).
+    c.servo.Expect(Apply(MapFromServoFrame().inverse(), goal.position), goal.bush->Radius());
+  }
+  const perception::PointCloud cloud = c.bush_stereo->ComputePair(frame, pair).cloud;
+  const auto ground = perception::FitGroundPlane(cloud);
+  perception::BushShape shape = *goal.bush;
+  shape.yaw -= c.ekf.Estimate().pose.yaw;  // map -> base_link
+  const auto estimate = perception::FitBush(cloud, ground.value_or(perception::GroundPlane{}), shape,
+                                            ExpectedBushInBase(), parameters_.bush_approach.fit, &sighting.failure);
+  ++bush_status_.frames;
+  if (estimate) {
+    sighting.found = true;
+    sighting.centre_base = estimate->centre;
+    sighting.scale = estimate->scale;
+    sighting.points = estimate->points;
+    const Eigen::Vector2d from_arm = estimate->centre - c.arm_axis;
+    sighting.distance = from_arm.norm();
+    sighting.bearing = std::atan2(from_arm.y(), from_arm.x());
+    // The odometry pose at the frame: wheel ticks up to the frame have been added.
+    sighting.tracked = c.servo.AddMeasurement(frame.stamp, c.servo_odometry.pose(), estimate->centre);
+    if (!sighting.tracked) sighting.failure = "too far from the track";
+    bush_status_.tracked += sighting.tracked ? 1 : 0;
+  } else {
+    c.servo.AddMiss(frame.stamp);
+  }
+  pending_sightings_.push_back(std::move(sighting));
 }
 
 void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
@@ -358,6 +552,8 @@ messages::RobotCommands RobotStack::Update(double stamp) {
   telemetry_.events.clear();
   telemetry_.registration = std::move(pending_registration_);
   pending_registration_.reset();
+  telemetry_.bush_sightings = std::move(pending_sightings_);
+  pending_sightings_.clear();
   DeliverVisualFixes(stamp);
   if (stamp + 1e-9 >= next_control_) {
     // Control ticks at whole multiples of the period (no drift from summing periods).
@@ -381,21 +577,79 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   if (navigator == nullptr) return;
   const double planning_before = navigator->planning_seconds();
   const auto start = std::chrono::steady_clock::now();
-  if (LocalizationLost()) {
+  if (servoing_) {
+    // On odometry and stereo alone: the servo needs no map pose.
+    RunBushServo(stamp, commands);
+  } else if (LocalizationLost()) {
     // Better to stand than to drive blind: wait for the localization to come back.
     commands->base = messages::BaseVelocityCommand{};
-    last_linear_command_ = 0.0;
     ++telemetry_.visual.stopped_updates;
-    return;
+  } else {
+    commands->base = navigator->Update(stamp, components_->ekf.Estimate().pose);
+    telemetry_.events = navigator->TakeEvents();
+    HandleNavigationEvents(stamp);
   }
-  commands->base = navigator->Update(stamp, components_->ekf.Estimate().pose);
   last_linear_command_ = commands->base ? commands->base->linear : 0.0;
-  telemetry_.events = navigator->TakeEvents();
-  telemetry_.mission = ToMission(navigator->mode());
-  telemetry_.current_goal = navigator->current_goal();
+  UpdateMissionTelemetry();
   const double planning = navigator->planning_seconds() - planning_before;
   telemetry_.timings.planning += planning;
   telemetry_.timings.control += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - planning;
+}
+
+void RobotStack::HandleNavigationEvents(double stamp) {
+  for (NavigationEvent& event : telemetry_.events) {
+    if (event.type != NavigationEvent::Type::kGoalReached || event.goal != bush_goal_) continue;
+    // By map at the bush's approach point: the bush goal itself is reached by visual servoing.
+    event.type = NavigationEvent::Type::kApproachReached;
+    servoing_ = true;
+    components_->servo.Start(stamp);
+  }
+}
+
+void RobotStack::RunBushServo(double stamp, messages::RobotCommands* commands) {
+  BushServo& servo = components_->servo;
+  commands->base = servo.Update(stamp, components_->servo_odometry.pose());
+  if (servo.mode() == BushServo::Mode::kDone) {
+    const Eigen::Vector2d db = servo.DistanceBearing(components_->servo_odometry.pose());
+    FinishBushGoal(stamp, true, std::to_string(db.x()) + " m, " + std::to_string(db.y() * 180.0 / M_PI) + " deg");
+  } else if (servo.mode() == BushServo::Mode::kFailed) {
+    FinishBushGoal(stamp, false, servo.failure());
+  }
+}
+
+void RobotStack::FinishBushGoal(double stamp, bool reached, const std::string& detail) {
+  NavigationEvent event;
+  event.stamp = stamp;
+  event.type = reached ? NavigationEvent::Type::kGoalReached : NavigationEvent::Type::kGoalFailed;
+  event.goal = bush_goal_;
+  event.detail = detail;
+  event.position = Apply(MapFromServoFrame(), components_->servo.centre());  // the bush's centre as tracked
+  telemetry_.events.push_back(event);
+  servoing_ = false;
+  if (!reached) {
+    mission_failed_ = true;
+    return;
+  }
+  next_goal_ = bush_goal_ + 1;
+  StartSegment();  // the rest of the mission (none: the navigator is done)
+}
+
+void RobotStack::UpdateMissionTelemetry() {
+  const Navigator& navigator = *components_->navigator;
+  telemetry_.mission = mission_failed_ ? MissionState::kFailed
+                       : servoing_     ? MissionState::kDriving
+                                       : ToMission(navigator.mode());
+  telemetry_.current_goal = servoing_ || mission_failed_ ? bush_goal_ : navigator.current_goal();
+  if (bush_goal_ < 0) {
+    telemetry_.bush.reset();
+    return;
+  }
+  const BushServo& servo = components_->servo;
+  bush_status_.mode = servoing_ ? ToString(servo.mode()) : "navigating";
+  const Eigen::Vector2d db = servo.DistanceBearing(components_->servo_odometry.pose());
+  bush_status_.distance = db.x();
+  bush_status_.bearing = db.y();
+  telemetry_.bush = bush_status_;
 }
 
 }  // namespace trimbot::stack

@@ -176,6 +176,39 @@ void ReadObstacles(Reader& r, ObstacleDetectionParameters& p) {
   if (points.ground_tolerance > points.min_height) r.map().Fail("ground_tolerance", "must not exceed min_height");
 }
 
+void ReadBushApproach(Reader& r, BushApproachParameters& p) {
+  r.Number("rate_hz", &p.rate_hz, 0.01, 100.0, "Hz");
+  r.Number("sighting_range", &p.sighting_range, 0.5, 20.0, "m");
+  r.Number("approach_margin", &p.approach_margin, 0.0, 5.0, "m");
+  r.Degrees("max_bearing_deg", &p.max_bearing, 1.0, 90.0);
+  r.Section("fit", [&](Reader& f) {
+    perception::BushFitOptions& o = p.fit;
+    f.Number("gate", &o.gate, 0.0, 2.0, "m");
+    f.Number("refit_gate", &o.refit_gate, 0.005, 1.0, "m");
+    f.Number("min_height", &o.min_height, 0.0, 1.0, "m");
+    f.Number("max_position_sigma", &o.max_position_sigma, 1e-4, 10.0, "m");
+    f.Integer("min_points", &o.min_points, 3, 1000000);
+    f.Integer("max_points", &o.max_points, 3, 1000000);
+    f.Number("huber", &o.huber, 1e-4, 1.0, "m");
+    f.Number("scale_sigma", &o.scale_sigma, 1e-3, 10.0);
+    if (o.max_points < o.min_points) f.map().Fail("max_points", "must be at least min_points");
+  });
+  r.Section("servo", [&](Reader& f) {
+    BushServoParameters& o = p.servo;
+    f.Number("surface_gap", &o.surface_gap, 0.0, 3.0, "m");
+    f.Degrees("bearing_deg", &o.bearing, -180.0, 180.0);
+    f.Number("distance_tolerance", &o.distance_tolerance, 1e-4, 1.0, "m");
+    f.Degrees("bearing_tolerance_deg", &o.bearing_tolerance, 0.01, 45.0);
+    f.Number("max_speed", &o.max_speed, 0.001, 1.0, "m/s");
+    f.Number("max_turn_rate", &o.max_turn_rate, 0.001, 3.0, "rad/s");
+    f.Number("max_jump", &o.max_jump, 0.001, 2.0, "m");
+    f.Number("memory", &o.memory, 0.0, 1.0);
+    f.Integer("settle_frames", &o.settle_frames, 0, 100);
+    f.Integer("max_lost_frames", &o.max_lost_frames, 0, 1000);
+    f.Number("timeout", &o.timeout, 1.0, 1e5, "s");
+  });
+}
+
 void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
   const std::string name = map.String("localization");
   if (name == "none") {
@@ -198,6 +231,7 @@ void Read(Reader& r, StackParameters& s) {
   r.Section("ekf", [&](Reader& f) { ReadEkf(f, s.ekf); });
   r.Section("visual_localization", [&](Reader& f) { ReadVisual(f, s.visual); });
   r.Section("navigation", [&](Reader& f) { ReadNavigation(f, s); });
+  r.Section("bush_approach", [&](Reader& f) { ReadBushApproach(f, s.bush_approach); });
   r.Section("perception", [&](Reader& perception) {
     perception.Section("local_fusion", [&](Reader& f) {
       perception::LocalFusionOptions& p = s.local_fusion;

@@ -46,4 +46,25 @@ class WheelOdometry {
   double angular_velocity_ = 0.0;
 };
 
+// Wheel distance with the gyro's heading, in a local frame that starts at the origin. On grass the
+// wheels slip sideways in turns on the spot (wheel odometry lost ~10 deg of heading in a few
+// turns), the gyro does not: the visual servo tracks the bush in this frame. The gyro's bias comes
+// from the caller (the EKF estimates it).
+class GyroOdometry {
+ public:
+  GyroOdometry(const robot::DiffDriveGeometry& geometry, int ticks_per_revolution)
+      : wheels_(geometry, ticks_per_revolution) {}
+  // The yaw rate about base_link's z (bias removed), integrated into the heading.
+  void AddYawRate(double stamp, double yaw_rate);
+  // Travel since the previous reading, along the mean heading between the two readings.
+  void AddWheelTicks(const messages::WheelTicks& ticks);
+  const Pose2& pose() const { return pose_; }
+
+ private:
+  WheelOdometry wheels_;        // its distance travelled; its heading is not used
+  double last_gyro_stamp_ = -1.0;
+  double heading_at_ticks_ = 0.0;  // at the previous wheel reading
+  Pose2 pose_;
+};
+
 }  // namespace trimbot::stack

@@ -43,6 +43,7 @@ struct NavigationEvent {
     kPlanned, kPlanFailed, kGoalReached, kGoalFailed, kObstacleStop, kRecovered,
     kPathBlocked,   // an obstacle seen on the path ahead: plan again
     kGoalAdjusted,  // the goal was in an obstacle's clearance: `position` is the goal used instead
+    kApproachReached,  // a bush goal's approach point, reached by map: visual servoing starts
   };
   double stamp = 0.0;
   Type type = Type::kPlanned;
@@ -63,7 +64,9 @@ class Navigator {
   Navigator(const Navigator&) = delete;
   Navigator& operator=(const Navigator&) = delete;
 
-  void SetGoals(const std::vector<Eigen::Vector2d>& goals);
+  // Goals visited in order; events and current_goal() count them from `first_index` (the goals
+  // may be a part of a longer mission).
+  void SetGoals(const std::vector<Eigen::Vector2d>& goals, int first_index = 0);
   // The prior map with what perception has seen added (same size, resolution and origin as the
   // prior map; std::invalid_argument otherwise). The path ahead is checked against it.
   void SetCostmap(OccupancyGrid costmap);
@@ -71,9 +74,11 @@ class Navigator {
 
   // Smallest distance from the footprint at `pose` to an obstacle of the costmap (negative: overlap).
   double FootprintClearance(const Pose2& pose) const;
+  // m: a goal with this much clearance can be arrived at from any direction (GlobalPlanner).
+  double ArrivalClearance() const { return planner_.ArrivalClearance(); }
 
   Mode mode() const { return mode_; }
-  int current_goal() const { return goal_; }
+  int current_goal() const { return first_index_ + goal_; }
   const std::vector<Eigen::Vector2d>& path() const { return follower_.path(); }
   const OccupancyGrid& costmap() const { return costmap_; }
   // Events since the last call.
@@ -99,6 +104,7 @@ class Navigator {
   PathFollower follower_;
   std::vector<Eigen::Vector2d> goals_;
   int goal_ = 0;
+  int first_index_ = 0;
   Mode mode_ = Mode::kIdle;
   int recoveries_ = 0;
   int plan_failures_ = 0;

@@ -8,6 +8,7 @@
 //
 // Use:  RobotStack stack(files, parameters, seed);
 //       stack.SetInitialPose(0, believed_start);  stack.SetMap(map_yaml);  stack.SetGoals(goals);
+//       (a goal is a point, or Goal::ApproachBush: by map to ~1 m, then visual servoing)
 //       per sensor message: stack.Add(message);   then: commands = stack.Update(now);
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -19,6 +20,7 @@
 
 #include "trimbot/messages/commands.h"
 #include "trimbot/messages/sensor_messages.h"
+#include "trimbot/perception/bush_estimator.h"
 #include "trimbot/robot/robot_files.h"
 #include "trimbot/stack/stack_parameters.h"
 #include "trimbot/visual_localization/localizer.h"
@@ -36,6 +38,8 @@ struct StackTimings {
   double perception = 0.0;           // stereo clouds and their registration (local fusion)
   double obstacles = 0.0;            // stereo on the pairs ahead, obstacle points, layer, costmap
   long obstacle_pairs = 0;           // stereo pairs those went through
+  double bush = 0.0;                 // stereo on the pair facing a bush and the bush's shape fit
+  long bush_frames = 0;              // frames that went through
   double planning = 0.0;             // global plans (RRT*)
   double control = 0.0;              // navigator and path follower, planning excluded
   // Visual localization: each localized frame's time by stage (features, retrieval, matching, pose).
@@ -57,6 +61,42 @@ struct ObstacleCounters {
   int costmap_updates = 0;  // times the navigator got a new costmap
 };
 
+// A goal of the mission: a point to drive to, or a bush to approach for trimming (by map to an
+// approach point, then by visual servoing until the arm's axis stands at the standoff).
+struct Goal {
+  Goal(const Eigen::Vector2d& point) : position(point) {}  // NOLINT(google-explicit-constructor): a point is a goal
+  Goal(double x, double y) : position(x, y) {}
+  // The bush as the survey knows it: its centre in the map and its shape (yaw in the map frame).
+  static Goal ApproachBush(const Eigen::Vector2d& centre, const perception::BushShape& shape);
+  Eigen::Vector2d position;                   // the point, or the bush's surveyed centre
+  std::optional<perception::BushShape> bush;  // set for a bush approach
+};
+
+// One frame in which the stack looked for the bush of a bush goal.
+struct BushSighting {
+  double stamp = 0.0;      // of the frame
+  int goal = 0;
+  bool found = false;      // the shape fit gave a centre
+  bool tracked = false;    // and the track took it
+  Eigen::Vector2d centre_base = Eigen::Vector2d::Zero();  // base_link, at the frame's stamp
+  double distance = 0.0;   // m, from the arm's axis to the centre
+  double bearing = 0.0;    // rad, of the centre seen from the arm's axis (base_link's x: 0)
+  double scale = 1.0;      // fitted size / surveyed size
+  int points = 0;
+  std::string failure;     // when not found
+};
+
+// The bush approach under way (servo mode, the track as the arm sees it, the target).
+struct BushApproachStatus {
+  int goal = -1;
+  std::string mode;               // BushServo's mode
+  double distance = 0.0;          // m: tracked centre from the arm's axis, now (odometry)
+  double bearing = 0.0;           // rad
+  double target_distance = 0.0;   // m: the standoff
+  double target_bearing = 0.0;    // rad
+  int frames = 0, tracked = 0;    // sightings so far for this goal, and taken by the track
+};
+
 // What the stack reports after an update, for logs and evaluation.
 struct Telemetry {
   double stamp = 0.0;
@@ -72,6 +112,8 @@ struct Telemetry {
   std::vector<messages::PoseFix> visual_fixes;  // the stack's own fixes applied in the last update
   VisualLocalizationCounters visual;
   ObstacleCounters obstacles;
+  std::vector<BushSighting> bush_sightings;   // looked for in the frames since the last update
+  std::optional<BushApproachStatus> bush;     // while a bush goal is the current one
   StackTimings timings;
 };
 
@@ -84,6 +126,10 @@ std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const 
 
 class RobotStack {
  public:
+  // Whether a stack with `parameters` on this mission uses the ring's images (the driver must then
+  // deliver what RingRequestAt asks for): its parameters say so, or a goal approaches a bush.
+  static bool UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals);
+
   // `seed` seeds the stack's randomized algorithms (the planner's RRT*): same seed, same plans.
   // Throws InputError naming the file and key when a file is missing or malformed.
   RobotStack(const robot::RobotFiles& files, const StackParameters& parameters, std::uint64_t seed);
@@ -102,7 +148,7 @@ class RobotStack {
   void SetVisualMap(const std::string& map_path);
   // Goals in the map frame, visited in order; navigation starts with the next update. Needs the
   // prior map, and with localization: visual the visual map (std::logic_error otherwise).
-  void SetGoals(const std::vector<Eigen::Vector2d>& goals);
+  void SetGoals(const std::vector<Goal>& goals);
   // Drive by hand: the command passes through to the base (navigation stays idle); the stack
   // still estimates its pose and runs perception.
   void SetTeleopCommand(const messages::BaseVelocityCommand& command);
@@ -139,6 +185,23 @@ class RobotStack {
   // The stereo pairs (indices into the rig's pairs) facing the direction of travel.
   std::vector<int> PairsAhead() const;
   void DetectObstacles(const messages::RingFrame& frame);
+  // Mission: gives the navigator the goals from next_goal_ up to the next bush goal (its approach
+  // point), from the robot's estimated position.
+  void StartSegment();
+  Eigen::Vector2d ApproachPoint(const Goal& goal, const Eigen::Vector2d& from) const;
+  // The current bush goal's bush in base_link (map belief, or the track once there is one).
+  Eigen::Vector2d ExpectedBushInBase() const;
+  // The stereo pair facing the current bush goal's bush, if one does and it is in sighting range.
+  std::optional<int> PairFacingBush() const;
+  bool BushSightingDue(double stamp) const;
+  void LookForBush(const messages::RingFrame& frame);
+  // Translates the navigator's events for the mission and starts the servo at a bush's approach point.
+  void HandleNavigationEvents(double stamp);
+  void RunBushServo(double stamp, messages::RobotCommands* commands);
+  void FinishBushGoal(double stamp, bool reached, const std::string& detail);
+  // The map pose of the servo's frame (GyroOdometry), by the EKF's estimate now.
+  Eigen::Isometry3d MapFromServoFrame() const;
+  void UpdateMissionTelemetry();
 
   StackParameters parameters_;
   struct Components;
@@ -156,6 +219,16 @@ class RobotStack {
   double next_localization_ = 0.0;
   double next_obstacle_frame_ = 0.0;
   double last_linear_command_ = 0.0;  // m/s: its sign is the direction of travel
+  // The mission (SetGoals): goals before next_goal_ are done; bush_goal_ is the bush goal of the
+  // current segment (-1: none), servoing_ whether its visual servoing has started.
+  std::vector<Goal> mission_;
+  int next_goal_ = 0;
+  int bush_goal_ = -1;
+  bool servoing_ = false;
+  bool mission_failed_ = false;
+  double next_bush_frame_ = 0.0;
+  std::vector<BushSighting> pending_sightings_;  // reported by the next update
+  BushApproachStatus bush_status_;
 };
 
 }  // namespace trimbot::stack

@@ -6,8 +6,10 @@
 #include <string>
 
 #include "trimbot/common/yaml_reader.h"
+#include "trimbot/perception/bush_estimator.h"
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/perception/obstacle_points.h"
+#include "trimbot/stack/bush_servo.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
 #include "trimbot/stack/obstacle_layer.h"
@@ -51,6 +53,18 @@ struct ObstacleDetectionParameters {
   ObstacleLayerParameters layer;
 };
 
+// The bush approach (goals `approach_bush`): by map to an approach point approach_margin beyond
+// the standoff, then by visual servoing on the bush's centre from stereo. The bush is looked for
+// at rate_hz with the pair facing it once its mapped centre is within sighting_range.
+struct BushApproachParameters {
+  double rate_hz = 2.5;             // bush frames per second
+  double sighting_range = 3.3;      // m from the arm's axis to the mapped centre
+  double approach_margin = 0.4;     // m
+  double max_bearing = 0.45;        // rad: the bush must be this close to a pair's optical axis
+  perception::BushFitOptions fit;
+  BushServoParameters servo;
+};
+
 struct StackParameters {
   LocalizationSource localization = LocalizationSource::kNone;
   double initial_position_sigma = 0.2;  // m per axis
@@ -60,6 +74,7 @@ struct StackParameters {
   NavigatorParameters navigation;
   perception::LocalFusionOptions local_fusion;
   ObstacleDetectionParameters obstacles;
+  BushApproachParameters bush_approach;
   VisualLocalizationParameters visual;
 
   // Some component uses the ring's images (the driver must deliver what RingRequestAt asks for).
