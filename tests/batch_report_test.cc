@@ -15,7 +15,9 @@
 #include "reports/run_timing.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
+#include "eval/trial_evaluator.h"
 #include "eval/trial_result.h"
+#include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -474,6 +476,34 @@ TEST(RunTiming, StagesAccountForTheWallTimeAndAddUpOverTrials) {
   WriteRunTimingChart(png, "test", run);
   EXPECT_FALSE(cv::imread(png).empty());
   EXPECT_NE(FormatRunTiming(run).find("render_draw"), std::string::npos);
+}
+
+
+// Clearance is measured with the base's outline at the true pose against the garden as it is:
+// positive before an obstacle, negative as deep as the outline reaches into it.
+TEST(TrialEvaluator, MeasuresClearanceOfTheBaseOutline) {
+  garden::OccupancyMap world;
+  world.resolution = 0.05;
+  world.origin = {-1.0, -2.0};
+  world.occupied = cv::Mat::zeros(80, 100, CV_8U);  // 5 x 4 m
+  // An obstacle over x 2.0..2.5, y -0.5..0.5.
+  world.occupied(cv::Rect(world.Cell({2.0, 0.475}), world.Cell({2.475, -0.5})) + cv::Size(1, 1)).setTo(255);
+  const auto clearance_at = [&](double x) {
+    TrialEvaluator evaluator({}, GoalCriteria{}, 1.0);
+    evaluator.MeasureClearance(world, {-0.12, -0.235}, {0.58, 0.235});
+    sim::SensorOutputs sensors;
+    std::vector<messages::PoseFix> fixes;
+    sim::GroundTruth truth;
+    truth.T_map_base.translation() = Eigen::Vector3d(x, 0.0, 0.0);
+    messages::RobotCommands commands;
+    stack::Telemetry telemetry;
+    evaluator.Observe({0.1, 0.1, sensors, fixes, truth, commands, &telemetry});
+    TrialResult result;
+    evaluator.Finish(true, 10.0, telemetry, &result);
+    return result.min_clearance_m.value_or(std::numeric_limits<double>::quiet_NaN());
+  };
+  EXPECT_NEAR(clearance_at(1.2), 2.0 - 1.78, 0.05) << "the outline's front at 1.78 m";
+  EXPECT_NEAR(clearance_at(1.6), 2.0 - 2.18, 0.05) << "0.18 m into the obstacle";
 }
 
 }  // namespace

@@ -46,6 +46,16 @@ TEST(RobotDescription, DriveGeometryComesFromTheWheels) {
   EXPECT_NEAR(robot.drive().wheel_separation + 0.05, 0.51, 1e-9);
 }
 
+// The outline the evaluation measures clearance with: the chassis box (0.70 long, from 0.12 behind
+// the axle) and the wheels' discs at +-0.23 m.
+TEST(RobotDescription, BaseOutlineIsTheChassisAndTheWheels) {
+  const auto [low, high] = LoadRobot().BaseOutline();
+  EXPECT_NEAR(low.x(), 0.23 - 0.35, 1e-9);
+  EXPECT_NEAR(high.x(), 0.23 + 0.35, 1e-9);
+  EXPECT_NEAR(high.y(), 0.23 + 0.005, 1e-9);
+  EXPECT_NEAR(low.y(), -high.y(), 1e-9);
+}
+
 TEST(RobotDescription, ArmHasJacoJ2n6s300Geometry) {
   const auto robot = LoadRobot();
   auto joint_origin = [&](const std::string& joint) -> Eigen::Vector3d {

@@ -1,5 +1,7 @@
 #include "trimbot/robot/robot_description.h"
 
+#include <limits>
+
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
@@ -111,6 +113,44 @@ Eigen::Isometry3d RobotDescription::FramePose(const std::string& link,
     current = model_->getLink(joint.parent_link_name);
   }
   return pose;
+}
+
+std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() const {
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d high = -low;
+  for (const std::string& name : {std::string(RobotFrames::kBase), std::string(RobotFrames::kLeftWheelLink),
+                                  std::string("right_wheel_link")}) {
+    const auto link = model_->getLink(name);
+    if (!link) continue;
+    const Eigen::Isometry3d T_base_link = FramePose(name);
+    for (const auto& collision : link->collision_array) {
+      if (!collision || !collision->geometry) continue;
+      // Half extents of the geometry's own bounding box.
+      Eigen::Vector3d half = Eigen::Vector3d::Zero();
+      const urdf::Geometry& g = *collision->geometry;
+      if (g.type == urdf::Geometry::BOX) {
+        const auto& box = static_cast<const urdf::Box&>(g);
+        half = 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z);
+      } else if (g.type == urdf::Geometry::CYLINDER) {
+        const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
+        half = Eigen::Vector3d(cylinder.radius, cylinder.radius, 0.5 * cylinder.length);
+      } else if (g.type == urdf::Geometry::SPHERE) {
+        half = Eigen::Vector3d::Constant(static_cast<const urdf::Sphere&>(g).radius);
+      } else {
+        continue;
+      }
+      const Eigen::Isometry3d T = T_base_link * ToIsometry(collision->origin);
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d local((corner & 1 ? 1 : -1) * half.x(), (corner & 2 ? 1 : -1) * half.y(),
+                                    (corner & 4 ? 1 : -1) * half.z());
+        const Eigen::Vector2d p = (T * local).head<2>();
+        low = low.cwiseMin(p);
+        high = high.cwiseMax(p);
+      }
+    }
+  }
+  if (!low.allFinite()) throw InputError(path_, "base_link and the wheels have no collision geometry");
+  return {low, high};
 }
 
 std::vector<std::string> RobotDescription::ArmJointNames() const {

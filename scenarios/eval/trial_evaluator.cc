@@ -132,28 +132,37 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
   in_contact_ = contact;
 }
 
-void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const std::vector<double>& circle_x,
-                                      double circle_radius) {
-  // Distance from every free cell to the nearest occupied one (cells outside the map: unknown).
-  cv::Mat free = world.occupied == 0;
+void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const Eigen::Vector2d& outline_min,
+                                      const Eigen::Vector2d& outline_max) {
+  // Signed distance: in free cells to the nearest occupied one, in occupied cells minus the
+  // distance to the nearest free one (cells outside the map: unknown).
+  cv::Mat free = world.occupied == 0, inside;
   cv::distanceTransform(free, world_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  world_distance_ *= world.resolution;
+  cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  world_distance_ = (world_distance_ - inside) * world.resolution;
   world_origin_ = world.origin;
   world_resolution_ = world.resolution;
-  circle_x_ = circle_x;
-  circle_radius_ = circle_radius;
+  // The outline's perimeter every ~2 cm.
+  outline_.clear();
+  const Eigen::Vector2d corners[4] = {outline_min, {outline_max.x(), outline_min.y()}, outline_max,
+                                      {outline_min.x(), outline_max.y()}};
+  for (int side = 0; side < 4; ++side) {
+    const Eigen::Vector2d a = corners[side], b = corners[(side + 1) % 4];
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.02)));
+    for (int k = 0; k < steps; ++k) outline_.push_back(a + (static_cast<double>(k) / steps) * (b - a));
+  }
 }
 
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   if (!world_distance_.empty()) {
-    for (double cx : circle_x_) {
-      const double x = truth.x + cx * std::cos(truth.yaw), y = truth.y + cx * std::sin(truth.yaw);
+    const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
+    for (const Eigen::Vector2d& p : outline_) {
+      const double x = truth.x + c * p.x() - s * p.y(), y = truth.y + s * p.x() + c * p.y();
       const int column = static_cast<int>(std::floor((x - world_origin_.x()) / world_resolution_));
       const int row = world_distance_.rows - 1 - static_cast<int>(std::floor((y - world_origin_.y()) / world_resolution_));
       if (column < 0 || row < 0 || column >= world_distance_.cols || row >= world_distance_.rows) continue;
-      // The cell's centre is within half a cell of the circle's: count that against the robot.
-      const double distance = world_distance_.at<float>(row, column) - 0.5 * world_resolution_;
-      min_clearance_ = std::min(min_clearance_, distance - circle_radius_);
+      // The point is within half a cell of its cell's centre: count that against the robot.
+      min_clearance_ = std::min(min_clearance_, world_distance_.at<float>(row, column) - 0.5 * world_resolution_);
     }
   }
   const stack::Pose2& estimate = step.telemetry->estimate.pose;

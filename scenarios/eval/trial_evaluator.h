@@ -41,9 +41,11 @@ class TrialEvaluator : public Observer {
   TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria, double fix_history_seconds);
 
   void Observe(const StepView& step) override;
-  // Also measure the smallest clearance between the robot's footprint (circles of `circle_radius`
-  // at `circle_x` along base_link's x) at its true pose and the garden as it is (`world`).
-  void MeasureClearance(const garden::OccupancyMap& world, const std::vector<double>& circle_x, double circle_radius);
+  // Also measure the smallest clearance between the robot's base outline (a rectangle in
+  // base_link, RobotDescription::BaseOutline) at its true pose and the garden as it is (`world`);
+  // negative: how deep the outline reaches into an obstacle's cells.
+  void MeasureClearance(const garden::OccupancyMap& world, const Eigen::Vector2d& outline_min,
+                        const Eigen::Vector2d& outline_max);
 
   // Completes `result` (status, goals, counts, errors) from what was observed; `finished`: the
   // stack ended its mission before the time limit.
@@ -87,12 +89,12 @@ class TrialEvaluator : public Observer {
   std::vector<double> sample_times_, fix_stamps_;  // for the localization rate
   long steps_ = 0;
   double timestep_ = 0.0;
-  // Clearance: metres from each world cell to the nearest occupied one (empty: not measured).
+  // Clearance: signed metres from each world cell to the nearest obstacle boundary (positive in
+  // free space; empty: not measured), and points along the base's outline in base_link.
   cv::Mat world_distance_;
   Eigen::Vector2d world_origin_ = Eigen::Vector2d::Zero();
   double world_resolution_ = 0.0;
-  std::vector<double> circle_x_;
-  double circle_radius_ = 0.0;
+  std::vector<Eigen::Vector2d> outline_;
   double min_clearance_ = std::numeric_limits<double>::infinity();
 };
 

@@ -68,8 +68,8 @@ struct TrialResult {
   double path_length_m = 0.0;      // ground truth
   int collisions = 0;              // separate contact events with garden objects
   double contact_seconds = 0.0;
-  // Smallest distance between the footprint at its true pose and the garden as it is (m,
-  // negative: overlap); absent when not measured.
+  // Smallest distance between the base's outline (URDF collision geometry of the base and wheels)
+  // at its true pose and the garden as it is (m, negative: overlap); absent when not measured.
   std::optional<double> min_clearance_m;
   int replans = 0;
   int recoveries = 0;              // obstacle stops followed by a recovery manoeuvre

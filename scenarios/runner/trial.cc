@@ -95,8 +95,8 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   criteria.arm_axis = simulator.robot().FramePose(robot::RobotFrames::kCameraRing).translation().head<2>();
   TrialEvaluator evaluator(goals, criteria,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
-  const stack::Footprint& footprint = parameters.navigation.planner.footprint;
-  evaluator.MeasureClearance(WorldMap(scenario, setup.paths), footprint.circle_x, footprint.circle_radius);
+  const auto [outline_min, outline_max] = simulator.robot().BaseOutline();
+  evaluator.MeasureClearance(WorldMap(scenario, setup.paths), outline_min, outline_max);
   StackController controller(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;

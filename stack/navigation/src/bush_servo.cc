@@ -62,7 +62,10 @@ bool BushServo::AddMeasurement(double stamp, const Pose2& odometry, const Eigen:
   // pose estimate's errors; later ones by the track.
   const double gate = parameters_.max_jump + (tracking() ? 0.0 : parameters_.first_gate_margin);
   if ((centre - this->centre()).norm() > gate) {
-    const bool confirmed = candidate_ && (centre - *candidate_).norm() <= parameters_.max_jump;
+    // Only near the map's belief: a neighbour seen twice (the bush hidden behind it) must not take
+    // the track away.
+    const bool confirmed = candidate_ && (centre - *candidate_).norm() <= parameters_.max_jump &&
+                           (centre - expected_).norm() <= parameters_.max_jump + parameters_.first_gate_margin;
     if (!confirmed) {
       candidate_ = centre;
       AddMiss(stamp);

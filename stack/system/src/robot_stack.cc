@@ -210,7 +210,7 @@ void RobotStack::SetGoals(const std::vector<Goal>& goals) {
 
 Eigen::Vector2d RobotStack::ApproachPoint(const Goal& goal, const Eigen::Vector2d& from) const {
   // base_link's position from which, turned to face the bush, the arm's axis is approach_margin
-  // beyond the standoff. Of the sides of the bush (every 10 deg) where the footprint at the
+  // beyond the standoff. Of the sides of the bush where the footprint at the
   // standoff clears the map (other than the bush), the nearest to where the robot comes from whose
   // approach point can be arrived at from any direction (RRT* reaches a goal only along an edge
   // from its nearest node, so a goal some headings cannot arrive at makes it fail at random);
@@ -219,10 +219,19 @@ Eigen::Vector2d RobotStack::ApproachPoint(const Goal& goal, const Eigen::Vector2
   const Navigator& navigator = *c.navigator;
   const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
   const double reach = standoff + parameters_.bush_approach.approach_margin + c.arm_axis.x();
+  // Sides every 10 deg; a box only towards its corners (+-15 deg), where two faces show: seen
+  // face-on, a box's centre along the face rests on its two leafy edges alone (3 deg off measured).
+  std::vector<double> sides;
+  if (goal.bush->kind == perception::BushShape::Kind::kBox) {
+    for (int k = 0; k < 4; ++k) {
+      for (double offset : {0.0, -15.0, 15.0}) sides.push_back(goal.bush->yaw + (45.0 + 90.0 * k + offset) * M_PI / 180.0);
+    }
+  } else {
+    for (int k = 0; k < 36; ++k) sides.push_back(2.0 * M_PI * k / 36.0);
+  }
   for (const double clearance : {navigator.ArrivalClearance(), parameters_.navigation.planner.robot_radius}) {
     std::optional<Eigen::Vector2d> best;
-    for (int k = 0; k < 36; ++k) {
-      const double angle = 2.0 * M_PI * k / 36.0;
+    for (const double angle : sides) {
       const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
       const Eigen::Vector2d approach = goal.position + reach * side;
       const Eigen::Vector2d at_standoff = goal.position + (standoff + c.arm_axis.x()) * side;

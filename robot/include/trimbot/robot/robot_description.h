@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "trimbot/robot/diff_drive.h"
@@ -43,6 +44,10 @@ class RobotDescription {
 
   DiffDriveGeometry drive() const { return drive_; }
   std::vector<std::string> ArmJointNames() const;
+  // The base's outline on the ground: the xy bounding box in base_link (min, max) of the collision
+  // geometry of base_link and the wheels (what touches a bush or an obstacle first; the ring and
+  // the arm at rest stand within it).
+  std::pair<Eigen::Vector2d, Eigen::Vector2d> BaseOutline() const;
 
  private:
   std::string path_;

@@ -56,7 +56,8 @@ class BushServo {
   void Start(double stamp);
   // A frame's centre of the bush in base_link, with the odometry pose at the frame's stamp.
   // Returns whether the track took it (false: too far from the track). Two frames in a row that
-  // agree with each other but not with the track start it again from them (the track was wrong).
+  // agree with each other but not with the track, and are near the map's belief, start it again
+  // from them (the track was wrong).
   bool AddMeasurement(double stamp, const Pose2& odometry, const Eigen::Vector2d& centre_base);
   // A frame in which the bush was looked for and not found.
   void AddMiss(double stamp);
