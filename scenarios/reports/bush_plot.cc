@@ -159,7 +159,7 @@ void WriteBushErrorPlot(const std::string& path, const std::string& title, const
       bar(0.12, frame(columns[i]), kTruth);
       bar(0.37, estimate(columns[i]), kEstimate);
       bar(0.62, reached(columns[i]), kReached);
-      if (columns.size() <= 40) PutTextCentred(image, columns[i].label, panel.At(x + 0.5, 0.0) + cv::Point(0, 14), 0.33, kAxis);
+      if (columns.size() <= 64) PutTextCentred(image, columns[i].label, panel.At(x + 0.5, 0.0) + cv::Point(0, 14), 0.3, kAxis);
     }
   };
   draw(100, "distance error (cm), by bush id", kReferenceDistanceCm, [](const Column& c) { return c.frame_distance_cm; },

@@ -1,0 +1,212 @@
+#include "trimbot/arm/arm_kinematics.h"
+
+#include <kdl/chain.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainiksolverpos_lma.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "trimbot/common/input_error.h"
+
+namespace trimbot::arm {
+namespace {
+
+KDL::Frame ToKdl(const urdf::Pose& pose) {
+  double x = 0, y = 0, z = 0, w = 1;
+  pose.rotation.getQuaternion(x, y, z, w);
+  return KDL::Frame(KDL::Rotation::Quaternion(x, y, z, w), KDL::Vector(pose.position.x, pose.position.y, pose.position.z));
+}
+
+Eigen::Isometry3d ToEigen(const KDL::Frame& frame) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    pose.translation()(r) = frame.p(r);
+    for (int c = 0; c < 3; ++c) pose.linear()(r, c) = frame.M(r, c);
+  }
+  return pose;
+}
+
+KDL::JntArray ToKdl(const Eigen::VectorXd& q) {
+  KDL::JntArray array(static_cast<unsigned>(q.size()));
+  array.data = q;
+  return array;
+}
+
+KDL::Frame ToKdl(const Eigen::Isometry3d& pose) {
+  KDL::Frame frame;
+  for (int r = 0; r < 3; ++r) {
+    frame.p(r) = pose.translation()(r);
+    for (int c = 0; c < 3; ++c) frame.M(r, c) = pose.linear()(r, c);
+  }
+  return frame;
+}
+
+// A van der Corput / Halton sequence in [0, 1): deterministic starts spread evenly over joint space.
+double Halton(int index, int base) {
+  double result = 0.0, fraction = 1.0 / base;
+  for (int i = index + 1; i > 0; i /= base, fraction /= base) result += fraction * (i % base);
+  return result;
+}
+
+}  // namespace
+
+struct ArmKinematics::Chain {
+  KDL::Chain chain;
+  std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk;
+  std::unique_ptr<KDL::ChainJntToJacSolver> jacobian;
+  std::unique_ptr<KDL::ChainIkSolverPos_LMA> ik;
+};
+
+ArmKinematics::ArmKinematics(const robot::RobotDescription& description) : chain_(std::make_unique<Chain>()) {
+  const urdf::ModelInterface& model = description.urdf();
+  // The joints from the cutter frame up to base_link, then in order from the base (as kdl_parser
+  // builds segments: the joint turns about its axis through the joint origin in the parent frame).
+  std::vector<urdf::JointConstSharedPtr> path;
+  for (auto link = model.getLink(robot::RobotFrames::kEndEffector); link && link->parent_joint;
+       link = model.getLink(link->parent_joint->parent_link_name)) {
+    path.push_back(link->parent_joint);
+  }
+  std::reverse(path.begin(), path.end());
+  if (path.empty() || path.front()->parent_link_name != robot::RobotFrames::kBase) {
+    throw InputError(description.path(), std::string("no chain from base_link to ") + robot::RobotFrames::kEndEffector);
+  }
+  for (const auto& joint : path) {
+    const KDL::Frame origin = ToKdl(joint->parent_to_joint_origin_transform);
+    KDL::Joint kdl_joint(joint->name, KDL::Joint::None);
+    if (joint->type == urdf::Joint::REVOLUTE || joint->type == urdf::Joint::CONTINUOUS) {
+      const KDL::Vector axis(joint->axis.x, joint->axis.y, joint->axis.z);
+      kdl_joint = KDL::Joint(joint->name, origin.p, origin.M * axis, KDL::Joint::RotAxis);
+      JointLimit limit;
+      limit.name = joint->name;
+      limit.continuous = joint->type == urdf::Joint::CONTINUOUS || !joint->limits;
+      if (!limit.continuous) {
+        limit.lower = joint->limits->lower;
+        limit.upper = joint->limits->upper;
+      }
+      limit.velocity = joint->limits ? joint->limits->velocity : 0.0;
+      if (limit.velocity <= 0.0) throw InputError(description.path(), "joint '" + joint->name + "' has no velocity limit");
+      limits_.push_back(limit);
+    } else if (joint->type != urdf::Joint::FIXED) {
+      throw InputError(description.path(), "joint '" + joint->name + "' of the arm chain is neither fixed nor revolute");
+    }
+    chain_->chain.addSegment(KDL::Segment(joint->child_link_name, kdl_joint, origin));
+    links_.push_back(joint->child_link_name);
+  }
+  if (limits_.size() != 6) {
+    throw InputError(description.path(), "the arm chain has " + std::to_string(limits_.size()) + " moving joints, not 6");
+  }
+  chain_->fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(chain_->chain);
+  chain_->jacobian = std::make_unique<KDL::ChainJntToJacSolver>(chain_->chain);
+}
+
+ArmKinematics::~ArmKinematics() = default;
+ArmKinematics::ArmKinematics(ArmKinematics&&) noexcept = default;
+ArmKinematics& ArmKinematics::operator=(ArmKinematics&&) noexcept = default;
+
+void ArmKinematics::CheckSize(const Eigen::VectorXd& q) const {
+  if (q.size() != joints()) {
+    throw std::invalid_argument("ArmKinematics: " + std::to_string(q.size()) + " joint positions for " +
+                                std::to_string(joints()) + " joints");
+  }
+}
+
+Eigen::Isometry3d ArmKinematics::EndEffectorPose(const Eigen::VectorXd& q) const {
+  CheckSize(q);
+  KDL::Frame frame;
+  chain_->fk->JntToCart(ToKdl(q), frame);
+  return ToEigen(frame);
+}
+
+std::vector<Eigen::Isometry3d> ArmKinematics::LinkPoses(const Eigen::VectorXd& q) const {
+  CheckSize(q);
+  const KDL::JntArray joints = ToKdl(q);
+  std::vector<Eigen::Isometry3d> poses;
+  for (int segment = 1; segment <= static_cast<int>(links_.size()); ++segment) {
+    KDL::Frame frame;
+    chain_->fk->JntToCart(joints, frame, segment);
+    poses.push_back(ToEigen(frame));
+  }
+  return poses;
+}
+
+Eigen::Matrix<double, 6, Eigen::Dynamic> ArmKinematics::Jacobian(const Eigen::VectorXd& q) const {
+  CheckSize(q);
+  KDL::Jacobian jacobian(static_cast<unsigned>(joints()));
+  chain_->jacobian->JntToJac(ToKdl(q), jacobian);
+  return jacobian.data;
+}
+
+double ArmKinematics::Manipulability(const Eigen::VectorXd& q) const {
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> J = Jacobian(q);
+  return std::sqrt(std::max(0.0, (J * J.transpose()).determinant()));
+}
+
+bool ArmKinematics::WithinLimits(const Eigen::VectorXd& q) const {
+  CheckSize(q);
+  for (int i = 0; i < joints(); ++i) {
+    const JointLimit& limit = limits_[static_cast<std::size_t>(i)];
+    if (!limit.continuous && (q(i) < limit.lower || q(i) > limit.upper)) return false;
+  }
+  return true;
+}
+
+IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options) const {
+  static constexpr int kPrimes[6] = {2, 3, 5, 7, 11, 13};
+  KDL::ChainIkSolverPos_LMA solver(chain_->chain, 1e-12, options.max_iterations);
+  const KDL::Frame goal = ToKdl(target);
+  IkResult result;
+  double closest_position = std::numeric_limits<double>::infinity(), closest_angle = closest_position;
+  int outside_limits = 0;
+  for (int start = 0; start < options.starts; ++start) {
+    KDL::JntArray seed(static_cast<unsigned>(joints())), solution(static_cast<unsigned>(joints()));
+    for (int i = 0; i < joints(); ++i) {
+      const JointLimit& limit = limits_[static_cast<std::size_t>(i)];
+      const double u = Halton(start, kPrimes[i]);
+      seed(i) = limit.continuous ? -M_PI + 2.0 * M_PI * u : limit.lower + (limit.upper - limit.lower) * u;
+    }
+    solver.CartToJnt(seed, goal, solution);
+    Eigen::VectorXd q = solution.data;
+    for (int i = 0; i < joints(); ++i) {
+      if (limits_[static_cast<std::size_t>(i)].continuous) q(i) = -std::remainder(-q(i), 2.0 * M_PI);  // (-pi, pi]
+    }
+    const Eigen::Isometry3d reached = EndEffectorPose(q);
+    const double position = (reached.translation() - target.translation()).norm();
+    const double angle = Eigen::AngleAxisd(reached.linear().transpose() * target.linear()).angle();
+    closest_position = std::min(closest_position, position);
+    closest_angle = std::min(closest_angle, angle);
+    if (position > options.position_tolerance || angle > options.orientation_tolerance) continue;
+    if (!WithinLimits(q)) {
+      ++outside_limits;
+      continue;
+    }
+    const bool known = std::any_of(result.solutions.begin(), result.solutions.end(), [&](const Eigen::VectorXd& s) {
+      Eigen::VectorXd d = s - q;
+      for (int i = 0; i < joints(); ++i) {
+        if (limits_[static_cast<std::size_t>(i)].continuous) d(i) = std::remainder(d(i), 2.0 * M_PI);
+      }
+      return d.cwiseAbs().maxCoeff() < options.distinct;
+    });
+    if (!known) result.solutions.push_back(q);
+  }
+  if (result.solutions.empty()) {
+    std::ostringstream why;
+    if (outside_limits > 0) {
+      why << "the pose is reached only outside the joint limits (" << outside_limits << " of " << options.starts
+          << " starts)";
+    } else {
+      why << "unreachable: the closest of " << options.starts << " starts ends " << closest_position << " m and "
+          << closest_angle * 180.0 / M_PI << " deg from the pose";
+    }
+    result.failure = why.str();
+  }
+  return result;
+}
+
+}  // namespace trimbot::arm
