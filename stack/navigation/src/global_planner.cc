@@ -121,6 +121,57 @@ std::optional<Eigen::Vector2d> GlobalPlanner::NearestWithClearance(const Eigen::
   return std::nullopt;
 }
 
+namespace {
+
+// m: where the planner arrives from when RRT* cannot join the goal itself (GlobalPlanner::Plan).
+constexpr double kGoalApproach = 0.4;
+
+// RRT* from `start` to `goal` on `si`, simplified; nullopt (with the reason in `*message`) when
+// the iterations found no exact solution.
+std::optional<std::vector<Eigen::Vector2d>> RrtStar(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& start,
+                                                    const Eigen::Vector2d& goal, double resolution, double range,
+                                                    unsigned iterations, std::string* message) {
+  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
+  from[0] = start.x();
+  from[1] = start.y();
+  to[0] = goal.x();
+  to[1] = goal.y();
+  auto problem = std::make_shared<ob::ProblemDefinition>(si);
+  problem->setStartAndGoalStates(from, to, 0.5 * resolution);
+  problem->setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(si));
+  auto planner = std::make_shared<og::RRTstar>(si);
+  planner->setRange(range);
+  planner->setProblemDefinition(problem);
+  planner->setup();
+  ob::IterationTerminationCondition budget(iterations);
+  const ob::PlannerStatus status = planner->solve(budget);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    if (message != nullptr) {
+      *message = std::string("no path found (") + status.asString() + ", " +
+                 std::to_string(problem->getSolutionDifference()) + " m short)";
+    }
+    return std::nullopt;
+  }
+  auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
+  og::PathSimplifier simplifier(si);
+  simplifier.simplifyMax(path);
+  std::vector<Eigen::Vector2d> points;
+  for (const ob::State* state : path.getStates()) points.push_back(Point(state));
+  return points;
+}
+
+// The motion validator's verdict on the straight segment a -> b.
+bool Motion(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
+  from[0] = a.x();
+  from[1] = a.y();
+  to[0] = b.x();
+  to[1] = b.y();
+  return si->checkMotion(from.get(), to.get());
+}
+
+}  // namespace
+
 PlanResult GlobalPlanner::Plan(const Eigen::Vector2d& start, const Eigen::Vector2d& goal, int attempt) const {
   PlanResult result;
   if (!Free(goal)) {
@@ -148,34 +199,24 @@ PlanResult GlobalPlanner::Plan(const Eigen::Vector2d& start, const Eigen::Vector
   si->setMotionValidator(std::make_shared<FootprintMotionValidator>(si, *this, planning_start));
   si->setup();
 
-  ob::ScopedState<ob::RealVectorStateSpace> from(space), to(space);
-  from[0] = planning_start.x();
-  from[1] = planning_start.y();
-  to[0] = goal.x();
-  to[1] = goal.y();
-  auto problem = std::make_shared<ob::ProblemDefinition>(si);
-  problem->setStartAndGoalStates(from, to, 0.5 * map_.resolution());
-  problem->setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(si));
-
-  auto planner = std::make_shared<og::RRTstar>(si);
-  planner->setRange(parameters_.range);
-  planner->setProblemDefinition(problem);
-  planner->setup();
-  ob::IterationTerminationCondition iterations(parameters_.iterations << std::clamp(attempt, 0, 4));
-  const ob::PlannerStatus status = planner->solve(iterations);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
-    result.message = std::string("no path found (") + status.asString() + ")";
-    return result;
+  // RRT* joins the goal only from its nearest tree node: a goal that some headings cannot arrive
+  // at (the footprint along the last segment) failed a third of the attempts when that node lay on
+  // such a side. Then plan to a point near the goal from which the last segment is valid instead.
+  const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
+  const double resolution = map_.resolution(), range = parameters_.range;
+  std::optional<std::vector<Eigen::Vector2d>> path =
+      RrtStar(si, planning_start, goal, resolution, range, iterations, &result.message);
+  for (int k = 0; k < 16 && !path; ++k) {
+    const double angle = 2.0 * M_PI * k / 16.0;
+    const Eigen::Vector2d before = goal + kGoalApproach * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    if (!Free(before) || !Motion(si, before, goal)) continue;
+    path = RrtStar(si, planning_start, before, resolution, range, iterations, nullptr);
+    if (path) path->push_back(goal);
   }
-  auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
-  og::PathSimplifier simplifier(si);
-  simplifier.simplifyMax(path);
-
+  if (!path) return result;
+  result.message.clear();
   if (planning_start != start) result.path.push_back(start);
-  for (const ob::State* state : path.getStates()) {
-    const auto* s = state->as<ob::RealVectorStateSpace::StateType>();
-    result.path.emplace_back(s->values[0], s->values[1]);
-  }
+  result.path.insert(result.path.end(), path->begin(), path->end());
   for (std::size_t i = 1; i < result.path.size(); ++i) result.length += (result.path[i] - result.path[i - 1]).norm();
   result.found = true;
   return result;
