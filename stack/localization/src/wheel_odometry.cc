@@ -12,6 +12,7 @@ void WheelOdometry::Update(const messages::WheelTicks& ticks) {
   const robot::WheelSpeeds rotation{static_cast<double>(ticks.left - last_->left) * radians_per_tick_,
                                     static_cast<double>(ticks.right - last_->right) * radians_per_tick_};
   const double distance = geometry_.LinearFromWheels(rotation);
+  last_distance_ = distance;
   const double turn = geometry_.AngularFromWheels(rotation);
   const double heading = pose_.yaw + 0.5 * turn;
   pose_.x += distance * std::cos(heading);
@@ -33,13 +34,11 @@ void GyroOdometry::AddYawRate(double stamp, double yaw_rate) {
 }
 
 void GyroOdometry::AddWheelTicks(const messages::WheelTicks& ticks) {
-  const Pose2 before = wheels_.pose();
   wheels_.Update(ticks);
-  const double distance = std::hypot(wheels_.pose().x - before.x, wheels_.pose().y - before.y);
-  const double direction = wheels_.linear_velocity() < 0.0 ? -1.0 : 1.0;
+  const double distance = wheels_.last_distance();
   const double heading = heading_at_ticks_ + 0.5 * std::remainder(pose_.yaw - heading_at_ticks_, 2.0 * M_PI);
-  pose_.x += direction * distance * std::cos(heading);
-  pose_.y += direction * distance * std::sin(heading);
+  pose_.x += distance * std::cos(heading);
+  pose_.y += distance * std::sin(heading);
   heading_at_ticks_ = pose_.yaw;
 }
 

@@ -48,16 +48,12 @@ void BushServo::Start(double stamp) {
 }
 
 Eigen::Vector2d BushServo::DistanceBearing(const Pose2& odometry) const {
-  const Eigen::Vector2d d = centre() - Eigen::Vector2d(odometry.x, odometry.y);
-  const double c = std::cos(odometry.yaw), s = std::sin(odometry.yaw);
-  const Eigen::Vector2d from_arm = Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y()) - arm_axis_;
+  const Eigen::Vector2d from_arm = IntoFrame(odometry, centre()) - arm_axis_;
   return {from_arm.norm(), std::atan2(from_arm.y(), from_arm.x())};
 }
 
 bool BushServo::AddMeasurement(double stamp, const Pose2& odometry, const Eigen::Vector2d& centre_base) {
-  const double c = std::cos(odometry.yaw), s = std::sin(odometry.yaw);
-  Eigen::Vector2d centre(odometry.x + c * centre_base.x() - s * centre_base.y(),
-                               odometry.y + s * centre_base.x() + c * centre_base.y());
+  Eigen::Vector2d centre = FromFrame(odometry, centre_base);
   // The first measurement is gated by the map's belief, which may be off by the map's and the
   // pose estimate's errors; later ones by the track.
   const double gate = parameters_.max_jump + (tracking() ? 0.0 : parameters_.first_gate_margin);

@@ -46,6 +46,22 @@ bool Delivered(const messages::RingFrame& frame, int camera) {
                      [camera](const messages::Image& image) { return image.camera_index == camera; });
 }
 
+// The cameras of stereo pairs, at the resolution stereo rectifies with (the calibration's).
+messages::RingRequest PairsRequest(const std::vector<robot::StereoPair>& pairs) {
+  messages::RingRequest request;
+  for (const robot::StereoPair& pair : pairs) {
+    request.cameras.push_back(pair.left);
+    request.cameras.push_back(pair.right);
+  }
+  std::sort(request.cameras.begin(), request.cameras.end());
+  request.resolution_scale = 1.0;
+  return request;
+}
+
+bool HasBushGoal(const std::vector<Goal>& goals) {
+  return std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
+}
+
 // A planar point through a (planar) transform.
 Eigen::Vector2d Apply(const Eigen::Isometry3d& T, const Eigen::Vector2d& p) {
   return (T * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>();
@@ -188,8 +204,7 @@ Goal Goal::ApproachBush(const Eigen::Vector2d& centre, const perception::BushSha
 }
 
 bool RobotStack::UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals) {
-  return parameters.UsesRingImages() ||
-         std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
+  return parameters.UsesRingImages() || HasBushGoal(goals);
 }
 
 void RobotStack::SetGoals(const std::vector<Goal>& goals) {
@@ -200,8 +215,7 @@ void RobotStack::SetGoals(const std::vector<Goal>& goals) {
   mission_ = goals;
   next_goal_ = 0;
   mission_failed_ = false;
-  const bool bushes = std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
-  if (bushes && !components_->bush_stereo) {
+  if (HasBushGoal(goals) && !components_->bush_stereo) {
     components_->bush_stereo = std::make_unique<perception::RingStereo>(components_->rig, perception::StereoOptions{});
   }
   StartSegment();
@@ -332,24 +346,15 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     request.resolution_scale = parameters_.visual.image_scale;
   }
   if (ObstacleDetectionDue(stamp)) {
-    messages::RingRequest ahead;
+    std::vector<robot::StereoPair> ahead;
     for (int pair : PairsAhead()) {
-      const robot::StereoPair& cameras =
-          components_->obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)].pair();
-      ahead.cameras.push_back(cameras.left);
-      ahead.cameras.push_back(cameras.right);
+      ahead.push_back(components_->obstacle_stereo->rectifiers()[static_cast<std::size_t>(pair)].pair());
     }
-    std::sort(ahead.cameras.begin(), ahead.cameras.end());
-    ahead.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
-    request = messages::Merge(request, ahead);
+    request = messages::Merge(request, PairsRequest(ahead));
   }
   if (BushSightingDue(stamp)) {
-    const robot::StereoPair cameras =
-        components_->bush_stereo->rectifiers()[static_cast<std::size_t>(*PairFacingBush())].pair();
-    messages::RingRequest bush;
-    bush.cameras = {std::min(cameras.left, cameras.right), std::max(cameras.left, cameras.right)};
-    bush.resolution_scale = 1.0;  // stereo rectifies with the calibration's image size
-    request = messages::Merge(request, bush);
+    const auto& facing = components_->bush_stereo->rectifiers()[static_cast<std::size_t>(*PairFacingBush())];
+    request = messages::Merge(request, PairsRequest({facing.pair()}));
   }
   if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
     messages::RingRequest stereo;
@@ -427,10 +432,8 @@ Eigen::Isometry3d RobotStack::MapFromServoFrame() const {
 
 Eigen::Vector2d RobotStack::ExpectedBushInBase() const {
   const Components& c = *components_;
-  const Eigen::Isometry3d T_base_odom = ToIsometry(c.servo_odometry.pose()).inverse();
-  if (c.servo.tracking()) return Apply(T_base_odom, c.servo.centre());
-  const Eigen::Isometry3d T_base_map = ToIsometry(c.ekf.Estimate().pose).inverse();
-  return Apply(T_base_map, mission_[static_cast<std::size_t>(bush_goal_)].position);
+  if (c.servo.tracking()) return IntoFrame(c.servo_odometry.pose(), c.servo.centre());
+  return IntoFrame(c.ekf.Estimate().pose, mission_[static_cast<std::size_t>(bush_goal_)].position);
 }
 
 std::optional<int> RobotStack::PairFacingBush() const {

@@ -26,6 +26,18 @@ inline Pose2 ToPose2(const Eigen::Isometry3d& T) {
   return {T.translation().x(), T.translation().y(), std::atan2(x_axis.y(), x_axis.x())};
 }
 
+// A planar point given in the frame of `pose` (e.g. base_link), in the frame the pose is in.
+inline Eigen::Vector2d FromFrame(const Pose2& pose, const Eigen::Vector2d& local) {
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  return {pose.x + c * local.x() - s * local.y(), pose.y + s * local.x() + c * local.y()};
+}
+// The inverse: a planar point of the pose's frame, in the frame of `pose`.
+inline Eigen::Vector2d IntoFrame(const Pose2& pose, const Eigen::Vector2d& point) {
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  const Eigen::Vector2d d = point - Eigen::Vector2d(pose.x, pose.y);
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y()};
+}
+
 class WheelOdometry {
  public:
   WheelOdometry(const robot::DiffDriveGeometry& geometry, int ticks_per_revolution)
@@ -36,6 +48,8 @@ class WheelOdometry {
   const Pose2& pose() const { return pose_; }
   double linear_velocity() const { return linear_velocity_; }
   double angular_velocity() const { return angular_velocity_; }
+  // m along base_link's x in the last update (negative: backwards).
+  double last_distance() const { return last_distance_; }
 
  private:
   robot::DiffDriveGeometry geometry_;
@@ -44,6 +58,7 @@ class WheelOdometry {
   Pose2 pose_;
   double linear_velocity_ = 0.0;
   double angular_velocity_ = 0.0;
+  double last_distance_ = 0.0;
 };
 
 // Wheel distance with the gyro's heading, in a local frame that starts at the origin. On grass the
@@ -61,7 +76,7 @@ class GyroOdometry {
   const Pose2& pose() const { return pose_; }
 
  private:
-  WheelOdometry wheels_;        // its distance travelled; its heading is not used
+  WheelOdometry wheels_;        // its distance per reading; its heading is not used
   double last_gyro_stamp_ = -1.0;
   double heading_at_ticks_ = 0.0;  // at the previous wheel reading
   Pose2 pose_;
