@@ -25,23 +25,26 @@ std::string Tum(double t, const stack::Pose2& pose) { return TumLine(t, stack::T
 
 }  // namespace
 
-TrialEvaluator::TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria,
-                               double fix_history_seconds)
-    : truths_(goals), criteria_(criteria), fix_history_seconds_(fix_history_seconds), bush_status_(goals.size()),
-      goal_planned_(goals.size(), false) {
+std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals) {
+  std::vector<GoalResult> results;
   for (const auto& goal : goals) {
     GoalResult result;
     result.x = result.used_x = goal.position.x();
     result.y = result.used_y = goal.position.y();
     result.bush = goal.bush;
-    goals_.push_back(result);
+    results.push_back(result);
   }
+  return results;
 }
 
+TrialEvaluator::TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria,
+                               double fix_history_seconds)
+    : truths_(goals), criteria_(criteria), fix_history_seconds_(fix_history_seconds), goals_(UnreachedGoals(goals)),
+      bush_status_(goals.size()), goal_planned_(goals.size(), false) {}
+
 Eigen::Vector2d TrialEvaluator::TrueBushDistanceBearing(const PlanarPose& truth, int goal) const {
-  const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
-  const Eigen::Vector2d d = truths_[static_cast<std::size_t>(goal)].position - Eigen::Vector2d(truth.x, truth.y);
-  const Eigen::Vector2d from_arm = Eigen::Vector2d(c * d.x() + s * d.y(), -s * d.x() + c * d.y()) - criteria_.arm_axis;
+  const Eigen::Vector2d from_arm =
+      stack::IntoFrame({truth.x, truth.y, truth.yaw}, truths_[static_cast<std::size_t>(goal)].position) - criteria_.arm_axis;
   return {from_arm.norm(), std::atan2(from_arm.y(), from_arm.x())};
 }
 
@@ -140,8 +143,7 @@ void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const E
   cv::distanceTransform(free, world_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   world_distance_ = (world_distance_ - inside) * world.resolution;
-  world_origin_ = world.origin;
-  world_resolution_ = world.resolution;
+  world_ = world;
   // The outline's perimeter every ~2 cm.
   outline_.clear();
   const Eigen::Vector2d corners[4] = {outline_min, {outline_max.x(), outline_min.y()}, outline_max,
@@ -155,14 +157,11 @@ void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const E
 
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   if (!world_distance_.empty()) {
-    const double c = std::cos(truth.yaw), s = std::sin(truth.yaw);
     for (const Eigen::Vector2d& p : outline_) {
-      const double x = truth.x + c * p.x() - s * p.y(), y = truth.y + s * p.x() + c * p.y();
-      const int column = static_cast<int>(std::floor((x - world_origin_.x()) / world_resolution_));
-      const int row = world_distance_.rows - 1 - static_cast<int>(std::floor((y - world_origin_.y()) / world_resolution_));
-      if (column < 0 || row < 0 || column >= world_distance_.cols || row >= world_distance_.rows) continue;
+      const cv::Point cell = world_.Cell(stack::FromFrame({truth.x, truth.y, truth.yaw}, p));
+      if (!cv::Rect(0, 0, world_distance_.cols, world_distance_.rows).contains(cell)) continue;
       // The point is within half a cell of its cell's centre: count that against the robot.
-      min_clearance_ = std::min(min_clearance_, world_distance_.at<float>(row, column) - 0.5 * world_resolution_);
+      min_clearance_ = std::min(min_clearance_, world_distance_.at<float>(cell) - 0.5 * world_.resolution);
     }
   }
   const stack::Pose2& estimate = step.telemetry->estimate.pose;

@@ -27,6 +27,9 @@ struct GoalTruth {
   int bush = 0;                                          // garden object id; 0: a point goal
 };
 
+// The goals as a trial's result lists them before any is reached (also a crashed trial's).
+std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals);
+
 // When a goal counts as reached (ground truth at the robot's declared arrival).
 struct GoalCriteria {
   double tolerance = 0.3;              // m from a point goal
@@ -92,8 +95,7 @@ class TrialEvaluator : public Observer {
   // Clearance: signed metres from each world cell to the nearest obstacle boundary (positive in
   // free space; empty: not measured), and points along the base's outline in base_link.
   cv::Mat world_distance_;
-  Eigen::Vector2d world_origin_ = Eigen::Vector2d::Zero();
-  double world_resolution_ = 0.0;
+  garden::OccupancyMap world_;  // its cells
   std::vector<Eigen::Vector2d> outline_;
   double min_clearance_ = std::numeric_limits<double>::infinity();
 };

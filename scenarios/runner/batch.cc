@@ -292,7 +292,7 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
 // nullopt while it runs.
 // `goals`: where the goals truly are (a crashed trial's result lists them unreached).
 std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& scenario,
-                                     const std::vector<Eigen::Vector2d>& goals) {
+                                     const std::vector<GoalTruth>& goals) {
   int status = 0;
   const pid_t done = waitpid(trial.pid, &status, WNOHANG);
   const double wall = std::chrono::duration<double>(Clock::now() - trial.started).count();
@@ -318,15 +318,7 @@ std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& 
   }
   if (!result) return std::nullopt;
   result->wall_seconds = wall;
-  if (result->goals.empty()) {
-    for (std::size_t i = 0; i < goals.size(); ++i) {
-      GoalResult goal;
-      goal.x = goal.used_x = goals[i].x();
-      goal.y = goal.used_y = goals[i].y();
-      goal.bush = scenario.goals[i].bush;
-      result->goals.push_back(goal);
-    }
-  }
+  if (result->goals.empty()) result->goals = UnreachedGoals(goals);
   if (result->status == "crashed" || result->status == "timeout") {
     WriteFileAtomically(trial.dir + "/result.json", json(*result).dump(2));
   }
@@ -354,7 +346,7 @@ int RunBatch(const BatchOptions& options) {
   StackParametersFor(scenario, options.paths);
   const garden::OccupancyMap map = PriorMap(scenario, options.paths);
   const std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
-  const std::vector<Eigen::Vector2d> true_goals = TrueGoalPositions(scenario, options.paths);
+  const std::vector<GoalTruth> true_goals = GoalTruths(scenario, options.paths);
   const std::string& out = options.out_dir;
   BatchInfo info;
   info.scenario_file = fs::absolute(options.scenario_path).string();

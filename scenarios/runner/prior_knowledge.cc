@@ -105,13 +105,13 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPat
   return goals;
 }
 
-std::vector<Eigen::Vector2d> TrueGoalPositions(const Scenario& scenario, const ProjectPaths& paths) {
+std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const ProjectPaths& paths) {
   const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
-  std::vector<Eigen::Vector2d> positions;
+  std::vector<GoalTruth> truths;
   for (const ScenarioGoal& goal : scenario.goals) {
-    positions.push_back(goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario).position);
+    truths.push_back({goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario).position, goal.bush});
   }
-  return positions;
+  return truths;
 }
 
 std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "eval/trial_evaluator.h"
 #include "runner/scenario.h"
 #include "runner/world_setup.h"
 #include "trimbot/garden/garden.h"
@@ -33,8 +34,8 @@ std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& di
 // or an object that is not a bush (topiary or rose).
 std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPaths& paths);
 // Where each goal truly is, for the evaluation: a point goal's position, a bush's true centre in
-// the world (the garden file's object).
-std::vector<Eigen::Vector2d> TrueGoalPositions(const Scenario& scenario, const ProjectPaths& paths);
+// the world (the garden file's object), with the bush's id.
+std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const ProjectPaths& paths);
 // The goals' positions as planned (a bush goal: its surveyed centre), for plots.
 std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals);
 

@@ -85,15 +85,12 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     fixes.emplace(scenario.simulated_pose_fixes, setup.seed);
   }
-  std::vector<GoalTruth> goals;
-  const std::vector<Eigen::Vector2d> true_positions = TrueGoalPositions(scenario, setup.paths);
-  for (std::size_t i = 0; i < true_positions.size(); ++i) goals.push_back({true_positions[i], scenario.goals[i].bush});
   GoalCriteria criteria;
   criteria.tolerance = scenario.goal_tolerance;
   criteria.bush_distance = scenario.bush_distance_tolerance;
   criteria.bush_bearing = scenario.bush_bearing_tolerance;
   criteria.arm_axis = simulator.robot().FramePose(robot::RobotFrames::kCameraRing).translation().head<2>();
-  TrialEvaluator evaluator(goals, criteria,
+  TrialEvaluator evaluator(GoalTruths(scenario, setup.paths), criteria,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
   const auto [outline_min, outline_max] = simulator.robot().BaseOutline();
   evaluator.MeasureClearance(WorldMap(scenario, setup.paths), outline_min, outline_max);
