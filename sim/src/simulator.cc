@@ -194,6 +194,7 @@ void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
   const bool ring_exposed = cameras_available && impl_->step % impl_->camera_steps == 0;
   *truth = ground_truth();
   truth->contacts = ObstacleContacts();
+  truth->arm_contacts = ArmContacts();
   truth->ring_exposed = ring_exposed;
   impl_->timings.physics += std::chrono::duration<double>(std::chrono::steady_clock::now() - physics_start).count();
   ++impl_->timings.physics_steps;
@@ -375,6 +376,22 @@ std::vector<ObstacleContact> Simulator::ObstacleContacts() const {
         contacts.push_back({mj_id2name(world.model(), mjOBJ_GEOM, robot_geom), object->geom_name, object->object_class});
       }
     }
+  }
+  return contacts;
+}
+
+std::vector<ArmContact> Simulator::ArmContacts() const {
+  const World& world = *impl_->world;
+  const mjModel* m = world.model();
+  const mjData* d = world.data();
+  constexpr int kArmBit = 4;  // the arm_collision class's contype (world_builder)
+  std::vector<ArmContact> contacts;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& contact = d->contact[i];
+    int arm = contact.geom1, other = contact.geom2;
+    if (!(m->geom_contype[arm] & kArmBit)) std::swap(arm, other);
+    if (!(m->geom_contype[arm] & kArmBit) || contact.dist > 0.0) continue;
+    contacts.push_back({mj_id2name(m, mjOBJ_GEOM, arm), mj_id2name(m, mjOBJ_GEOM, other), -contact.dist});
   }
   return contacts;
 }

@@ -98,6 +98,16 @@ class MjcfEmitter {
     labels_.push_back({name, ObjectClass::kRobot, garden::kRobotObjectId, false, garden::Surface::kGrass});
   }
 
+  // Whether an arm joint lies between the link and the root: its geoms may hit the robot itself.
+  static bool MovesWithArm(const urdf::Link& link) {
+    const urdf::Link* current = &link;
+    while (current->parent_joint) {
+      if (current->parent_joint->name.rfind("arm_joint_", 0) == 0) return true;
+      current = current->getParent().get();
+    }
+    return false;
+  }
+
   void LinkContents(const urdf::Link& link, int indent) {
     const std::string pad(indent, ' ');
     if (link.inertial) {
@@ -124,8 +134,8 @@ class MjcfEmitter {
       const auto& collision = *link.collision_array[i];
       // The passive front support is a skid: frictionless, and its settings win over the ground's.
       const std::string extra = collision.name == "front_support" ? " condim=\"1\" priority=\"1\"" : "";
-      Geom(*collision.geometry, collision.origin, link.name + "/collision" + std::to_string(i), "collision", extra,
-           indent);
+      Geom(*collision.geometry, collision.origin, link.name + "/collision" + std::to_string(i),
+           MovesWithArm(link) ? "arm_collision" : "collision", extra, indent);
     }
     if (link.name == RobotFrames::kCameraRing) Cameras(indent);
     for (const auto& child : link.child_links) ChildLink(*child, indent);
@@ -370,7 +380,11 @@ WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::Camera
       << "  <default>\n"
       << "    <default class=\"robot\">\n"
       << "      <default class=\"visual\"><geom contype=\"0\" conaffinity=\"0\" group=\"1\"/></default>\n"
-      << "      <default class=\"collision\"><geom contype=\"2\" conaffinity=\"1\" group=\"3\" friction=\"0.5 0.005 0.0001\"/></default>\n"
+      // Bits: 1 garden, 2 robot, 4 arm. The robot hits the garden; the arm also hits the robot
+      // (MuJoCo skips bodies welded together and parent-child pairs: the URDF's adjacent links).
+      << "      <default class=\"collision\"><geom contype=\"2\" conaffinity=\"5\" group=\"3\" friction=\"0.5 0.005 0.0001\"/>\n"
+      << "        <default class=\"arm_collision\"><geom contype=\"6\" conaffinity=\"5\"/></default>\n"
+      << "      </default>\n"
       << "      <default class=\"drive_joint\"><joint damping=\"0.01\" armature=\"0.01\"/></default>\n"
       << "      <default class=\"arm_joint\"><joint damping=\"3\" armature=\"0.05\"/></default>\n"
       << "    </default>\n"

@@ -75,6 +75,13 @@ struct ObstacleContact {
   garden::ObjectClass object_class = garden::ObjectClass::kNone;
 };
 
+// A contact of an arm link or the cutter with anything: the robot itself, the ground, the garden.
+struct ArmContact {
+  std::string arm_geom;
+  std::string other_geom;
+  double penetration = 0.0;  // m
+};
+
 // The renderer's truth about one ring frame.
 struct RingTruth {
   std::vector<RenderedView> views;              // depth/labels on ground-truth frames, else empty
@@ -96,6 +103,7 @@ struct GroundTruth {
   bool ring_exposed = false;
   std::optional<RingTruth> ring;                // with SensorOutputs::ring
   std::vector<ObstacleContact> contacts;        // robot against garden objects, now
+  std::vector<ArmContact> arm_contacts;         // the arm against anything, now
 };
 
 // Wall-clock seconds the simulator spent per stage since it was made (not part of any result:
@@ -161,6 +169,7 @@ class Simulator {
   // Applies the faults due at the current time; returns whether the cameras deliver images.
   bool ApplyFaults();
   std::vector<ObstacleContact> ObstacleContacts() const;
+  std::vector<ArmContact> ArmContacts() const;
   void ReadSensors(double stamp_before, SensorOutputs* sensors);
 
   SimulatorConfig config_;
