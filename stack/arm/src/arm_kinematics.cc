@@ -209,4 +209,21 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
   return result;
 }
 
+std::optional<Eigen::VectorXd> ArmKinematics::InverseKinematicsNear(const Eigen::Isometry3d& target,
+                                                                  const Eigen::VectorXd& seed,
+                                                                  const IkOptions& options) const {
+  CheckSize(seed);
+  KDL::ChainIkSolverPos_LMA solver(chain_->chain, 1e-12, options.max_iterations);
+  KDL::JntArray solution(static_cast<unsigned>(joints()));
+  solver.CartToJnt(ToKdl(seed), ToKdl(target), solution);
+  const Eigen::VectorXd q = solution.data;
+  const Eigen::Isometry3d reached = EndEffectorPose(q);
+  if ((reached.translation() - target.translation()).norm() > options.position_tolerance ||
+      Eigen::AngleAxisd(reached.linear().transpose() * target.linear()).angle() > options.orientation_tolerance ||
+      !WithinLimits(q)) {
+    return std::nullopt;
+  }
+  return q;
+}
+
 }  // namespace trimbot::arm

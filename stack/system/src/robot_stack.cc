@@ -84,6 +84,7 @@ const char* ToString(MissionState state) {
   switch (state) {
     case MissionState::kIdle: return "idle";
     case MissionState::kDriving: return "driving";
+    case MissionState::kReaching: return "reaching";
     case MissionState::kDone: return "done";
     case MissionState::kFailed: return "failed";
   }
@@ -107,6 +108,8 @@ struct RobotStack::Components {
   Eigen::Vector2d arm_axis;                                 // base_link: the arm's base (the ring's centre)
   std::unique_ptr<perception::RingStereo> bush_stereo;      // made with a mission that has bush goals
   BushServo servo;
+  arm::ArmExecutive arm;
+  std::unique_ptr<perception::RingStereo> arm_stereo;       // made with arm goals
   Rng latency_rng;
 
   Components(const robot::RobotFiles& files, const StackParameters& parameters)
@@ -119,6 +122,7 @@ struct RobotStack::Components {
         ekf(parameters.ekf, description.drive(), ticks_per_revolution),
         arm_axis(description.FramePose(robot::RobotFrames::kCameraRing).translation().head<2>()),
         servo(parameters.bush_approach.servo, arm_axis),
+        arm(description, parameters.arm),
         latency_rng(0) {
     if (parameters.local_fusion.enabled) fusion = std::make_unique<perception::LocalFusion>(rig, parameters.local_fusion);
     if (parameters.obstacles.enabled) {
@@ -203,8 +207,16 @@ Goal Goal::ApproachBush(const Eigen::Vector2d& centre, const perception::BushSha
   return goal;
 }
 
-bool RobotStack::UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals) {
-  return parameters.UsesRingImages() || HasBushGoal(goals);
+bool RobotStack::UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals, bool arm_goals) {
+  return parameters.UsesRingImages() || HasBushGoal(goals) || arm_goals;
+}
+
+void RobotStack::SetArmGoals(const std::vector<Eigen::Isometry3d>& cutter_poses) {
+  components_->arm.SetGoals(cutter_poses);
+  arm_mission_ = !cutter_poses.empty();
+  if (arm_mission_ && !components_->arm_stereo) {
+    components_->arm_stereo = std::make_unique<perception::RingStereo>(components_->rig, perception::StereoOptions{});
+  }
 }
 
 void RobotStack::SetGoals(const std::vector<Goal>& goals) {
@@ -309,15 +321,14 @@ void RobotStack::Add(const messages::WheelTicks& ticks) {
   components_->servo_odometry.AddWheelTicks(ticks);
 }
 
-void RobotStack::Add(const messages::ArmJointState& /*joints*/) {
-  // No arm software yet (the arm stack will track its joints here).
-}
+void RobotStack::Add(const messages::ArmJointState& joints) { components_->arm.SetJointState(joints); }
 
 void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
   if (VisualLocalizationDue(frame.stamp)) LocalizeVisually(frame);
   if (ObstacleDetectionDue(frame.stamp)) DetectObstacles(frame);
   if (BushSightingDue(frame.stamp)) LookForBush(frame);
+  if (ArmEnvironmentDue()) PerceiveArmEnvironment(frame);
   if (components_->fusion && components_->fusion->Wants(frame.stamp)) {
     ScopedTimer timer(&telemetry_.timings.perception);
     // The odometry pose at the frame's stamp: wheel ticks up to the frame have been added.
@@ -356,6 +367,7 @@ messages::RingRequest RobotStack::RingRequestAt(double stamp) const {
     const auto& facing = components_->bush_stereo->rectifiers()[static_cast<std::size_t>(*PairFacingBush())];
     request = messages::Merge(request, PairsRequest({facing.pair()}));
   }
+  if (ArmEnvironmentDue()) request = messages::Merge(request, PairsRequest(components_->rig.StereoPairs()));
   if (components_->fusion != nullptr && components_->fusion->Wants(stamp)) {
     messages::RingRequest stereo;
     for (int i = 0; i < components_->rig.size(); ++i) stereo.cameras.push_back(i);
@@ -565,12 +577,14 @@ messages::RobotCommands RobotStack::Update(double stamp) {
   telemetry_.registration = std::move(pending_registration_);
   pending_registration_.reset();
   telemetry_.bush_sightings = std::move(pending_sightings_);
+  telemetry_.arm_results.clear();
   pending_sightings_.clear();
   DeliverVisualFixes(stamp);
   if (stamp + 1e-9 >= next_control_) {
     // Control ticks at whole multiples of the period (no drift from summing periods).
     next_control_ = (std::floor((stamp + 1e-9) * parameters_.control_rate_hz) + 1.0) / parameters_.control_rate_hz;
     RunNavigation(stamp, &commands);
+    if (arm_mission_) RunArm(stamp, &commands);
   }
   telemetry_.stamp = stamp;
   telemetry_.estimate = c.ekf.Estimate();
@@ -662,6 +676,45 @@ void RobotStack::UpdateMissionTelemetry() {
   bush_status_.distance = db.x();
   bush_status_.bearing = db.y();
   telemetry_.bush = bush_status_;
+}
+
+bool RobotStack::ArmEnvironmentDue() const {
+  if (!arm_mission_ || !components_->arm.WantsEnvironment()) return false;
+  const bool navigation_done = mission_.empty() || telemetry_.mission == MissionState::kDone ||
+                               telemetry_.mission == MissionState::kReaching;
+  return navigation_done && std::abs(last_linear_command_) < 1e-9;
+}
+
+void RobotStack::PerceiveArmEnvironment(const messages::RingFrame& frame) {
+  ScopedTimer timer(&telemetry_.timings.arm);
+  Components& c = *components_;
+  perception::PointCloud seen;
+  for (std::size_t pair = 0; pair < c.arm_stereo->rectifiers().size(); ++pair) {
+    const robot::StereoPair& cameras = c.arm_stereo->rectifiers()[pair].pair();
+    if (!Delivered(frame, cameras.left) || !Delivered(frame, cameras.right)) continue;
+    const perception::PointCloud cloud = c.arm_stereo->ComputePair(frame, static_cast<int>(pair)).cloud;
+    for (std::size_t i = 0; i < cloud.size(); ++i) seen.Add(cloud.points[i], cloud.covariances[i]);
+  }
+  if (seen.empty()) return;  // no pair delivered: the next frame
+  c.arm.SetPerceivedPoints(seen.points, seen.covariances);
+  ++telemetry_.timings.arm_frames;
+}
+
+void RobotStack::RunArm(double stamp, messages::RobotCommands* commands) {
+  ScopedTimer timer(&telemetry_.timings.arm);
+  arm::ArmExecutive& arm = components_->arm;
+  const bool navigation_done = mission_.empty() || telemetry_.mission == MissionState::kDone ||
+                               telemetry_.mission == MissionState::kReaching;
+  if (telemetry_.mission == MissionState::kFailed || !navigation_done) return;
+  if (auto command = arm.Update(stamp)) commands->arm = *command;
+  telemetry_.arm_results = arm.TakeResults();
+  ArmStatus status;
+  status.mode = arm::ToString(arm.mode());
+  status.goal = arm.current_goal();
+  status.perceived_cells = arm.perceived_cells();
+  status.target.assign(arm.target().data(), arm.target().data() + arm.target().size());
+  telemetry_.arm = status;
+  telemetry_.mission = arm.mode() == arm::ArmExecutive::Mode::kDone ? MissionState::kDone : MissionState::kReaching;
 }
 
 }  // namespace trimbot::stack

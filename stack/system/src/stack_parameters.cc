@@ -209,6 +209,42 @@ void ReadBushApproach(Reader& r, BushApproachParameters& p) {
   });
 }
 
+void ReadArm(Reader& r, arm::ArmExecutiveParameters& p) {
+  r.Section("planner", [&](Reader& f) {
+    arm::ArmPlannerParameters& o = p.planner;
+    if (f.Wanted("algorithm")) {
+      const std::string name = f.map().String("algorithm");
+      if (name == "rrt_connect") {
+        o.algorithm = arm::ArmPlannerParameters::Algorithm::kRrtConnect;
+      } else if (name == "lazy_prm") {
+        o.algorithm = arm::ArmPlannerParameters::Algorithm::kLazyPrm;
+      } else {
+        f.map().Fail("algorithm", "unknown planner '" + name + "' (rrt_connect, lazy_prm)");
+      }
+    }
+    f.Integer("max_iterations", &o.max_iterations, 1, 10000000);
+    f.Number("collision_step", &o.collision_step, 1e-4, 0.5, "rad");
+    f.Number("velocity_scale", &o.velocity_scale, 0.01, 1.0);
+    f.Number("acceleration", &o.acceleration, 0.01, 100.0, "rad/s^2");
+    f.Number("cartesian_step", &o.cartesian_step, 1e-4, 0.1, "m");
+    f.Number("cartesian_max_joint_step", &o.cartesian_max_joint_step, 1e-3, 1.0, "rad");
+    f.Integer("ik_starts", &o.ik.starts, 1, 10000);
+  });
+  r.Section("environment", [&](Reader& f) {
+    f.Number("cell", &p.cell, 0.005, 0.5, "m");
+    f.Number("margin", &p.margin, 0.0, 0.5, "m");
+    f.Integer("min_points_per_cell", &p.min_points_per_cell, 1, 100000);
+    f.Number("max_point_sigma", &p.max_point_sigma, 1e-4, 10.0, "m");
+    f.Number("reach", &p.reach, 0.1, 10.0, "m");
+    f.Number("ground_clearance", &p.ground_clearance, 0.0, 1.0, "m");
+    f.Number("body_margin", &p.body_margin, 0.0, 1.0, "m");
+  });
+  r.Section("execution", [&](Reader& f) {
+    f.Number("settle_tolerance", &p.settle_tolerance, 1e-5, 1.0, "rad");
+    f.Number("settle_timeout", &p.settle_timeout, 0.01, 1000.0, "s");
+  });
+}
+
 void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
   const std::string name = map.String("localization");
   if (name == "none") {
@@ -232,6 +268,7 @@ void Read(Reader& r, StackParameters& s) {
   r.Section("visual_localization", [&](Reader& f) { ReadVisual(f, s.visual); });
   r.Section("navigation", [&](Reader& f) { ReadNavigation(f, s); });
   r.Section("bush_approach", [&](Reader& f) { ReadBushApproach(f, s.bush_approach); });
+  r.Section("arm", [&](Reader& f) { ReadArm(f, s.arm); });
   r.Section("perception", [&](Reader& perception) {
     perception.Section("local_fusion", [&](Reader& f) {
       perception::LocalFusionOptions& p = s.local_fusion;

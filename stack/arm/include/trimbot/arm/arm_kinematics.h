@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,10 @@ class ArmKinematics {
   bool WithinLimits(const Eigen::VectorXd& q) const;
   // Every distinct joint solution that puts the cutter frame at `target` (base_link).
   IkResult InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options = {}) const;
+  // The solution reached from `seed` alone (the branch the arm is on, for a small step of the
+  // cutter), continuous joints left near the seed's values; nullopt when it misses the pose or a limit.
+  std::optional<Eigen::VectorXd> InverseKinematicsNear(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed,
+                                                       const IkOptions& options = {}) const;
 
  private:
   void CheckSize(const Eigen::VectorXd& q) const;

@@ -27,7 +27,8 @@
 
 namespace trimbot::stack {
 
-enum class MissionState { kIdle, kDriving, kDone, kFailed };
+// kReaching: the base stands and the arm works through its goals (after the navigation goals).
+enum class MissionState { kIdle, kDriving, kReaching, kDone, kFailed };
 const char* ToString(MissionState state);
 
 // Wall-clock seconds per component since the start (not deterministic: for the run's timing
@@ -41,6 +42,8 @@ struct StackTimings {
   double bush = 0.0;                 // stereo on the pair facing a bush and the bush's shape fit
   long bush_frames = 0;              // frames that went through
   double planning = 0.0;             // global plans (RRT*)
+  double arm = 0.0;                  // arm: stereo of its surroundings, planning, execution
+  long arm_frames = 0;               // ring frames the arm's surroundings were perceived from
   double control = 0.0;              // navigator and path follower, planning excluded
   // Visual localization: each localized frame's time by stage (features, retrieval, matching, pose).
   std::vector<visual_localization::LocalizationTimings> visual_frames;
@@ -97,6 +100,14 @@ struct BushApproachStatus {
   int frames = 0, tracked = 0;    // sightings so far for this goal, and taken by the track
 };
 
+// The arm's goals under way.
+struct ArmStatus {
+  std::string mode;              // ArmExecutive's mode
+  int goal = 0;                  // index into the arm goals
+  int perceived_cells = 0;       // occupied cells of the environment the planner avoids
+  std::vector<double> target;    // rad: the joint targets commanded now (empty when not moving)
+};
+
 // What the stack reports after an update, for logs and evaluation.
 struct Telemetry {
   double stamp = 0.0;
@@ -114,6 +125,8 @@ struct Telemetry {
   ObstacleCounters obstacles;
   std::vector<BushSighting> bush_sightings;   // looked for in the frames since the last update
   std::optional<BushApproachStatus> bush;     // while a bush goal is the current one
+  std::optional<ArmStatus> arm;               // with arm goals
+  std::vector<arm::ArmGoalResult> arm_results;  // arm goals finished in the last update
   StackTimings timings;
 };
 
@@ -127,8 +140,9 @@ std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const 
 class RobotStack {
  public:
   // Whether a stack with `parameters` on this mission uses the ring's images (the driver must then
-  // deliver what RingRequestAt asks for): its parameters say so, or a goal approaches a bush.
-  static bool UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals);
+  // deliver what RingRequestAt asks for): its parameters say so, a goal approaches a bush, or the
+  // arm has goals (it perceives its surroundings).
+  static bool UsesRingImages(const StackParameters& parameters, const std::vector<Goal>& goals, bool arm_goals = false);
 
   // `seed` seeds the stack's randomized algorithms (the planner's RRT*): same seed, same plans.
   // Throws InputError naming the file and key when a file is missing or malformed.
@@ -149,6 +163,9 @@ class RobotStack {
   // Goals in the map frame, visited in order; navigation starts with the next update. Needs the
   // prior map, and with localization: visual the visual map (std::logic_error otherwise).
   void SetGoals(const std::vector<Goal>& goals);
+  // Cutter poses in base_link for the arm, reached in turn once the navigation goals (if any) are
+  // done, while the base stands. The arm plans around what the ring's stereo pairs see then.
+  void SetArmGoals(const std::vector<Eigen::Isometry3d>& cutter_poses);
   // Drive by hand: the command passes through to the base (navigation stays idle); the stack
   // still estimates its pose and runs perception.
   void SetTeleopCommand(const messages::BaseVelocityCommand& command);
@@ -202,6 +219,10 @@ class RobotStack {
   // The map pose of the servo's frame (GyroOdometry), by the EKF's estimate now.
   Eigen::Isometry3d MapFromServoFrame() const;
   void UpdateMissionTelemetry();
+  // The arm waits for its surroundings, the navigation goals are done, and the base stands.
+  bool ArmEnvironmentDue() const;
+  void PerceiveArmEnvironment(const messages::RingFrame& frame);
+  void RunArm(double stamp, messages::RobotCommands* commands);
 
   StackParameters parameters_;
   struct Components;
@@ -229,6 +250,7 @@ class RobotStack {
   double next_bush_frame_ = 0.0;
   std::vector<BushSighting> pending_sightings_;  // reported by the next update
   BushApproachStatus bush_status_;
+  bool arm_mission_ = false;  // SetArmGoals was given goals
 };
 
 }  // namespace trimbot::stack

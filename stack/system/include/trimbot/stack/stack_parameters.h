@@ -6,6 +6,7 @@
 #include <string>
 
 #include "trimbot/common/yaml_reader.h"
+#include "trimbot/arm/arm_executive.h"
 #include "trimbot/perception/bush_estimator.h"
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/perception/obstacle_points.h"
@@ -75,6 +76,7 @@ struct StackParameters {
   perception::LocalFusionOptions local_fusion;
   ObstacleDetectionParameters obstacles;
   BushApproachParameters bush_approach;
+  arm::ArmExecutiveParameters arm;  // arm goals: planning, the perceived environment, execution
   VisualLocalizationParameters visual;
 
   // Some component uses the ring's images (the driver must deliver what RingRequestAt asks for).
