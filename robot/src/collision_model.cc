@@ -92,6 +92,24 @@ void CollisionEnvironment::AddMesh(const std::string& name, const std::vector<Ei
   objects_->Add(name, model, pose);
 }
 
+void CollisionEnvironment::AddConvex(const std::string& name, const std::vector<Eigen::Vector3d>& vertices,
+                                     const std::vector<std::array<int, 3>>& triangles) {
+  auto points = std::make_shared<std::vector<fcl::Vector3d>>(vertices.begin(), vertices.end());
+  auto faces = std::make_shared<std::vector<int>>();
+  for (const auto& t : triangles) faces->insert(faces->end(), {3, t[0], t[1], t[2]});
+  objects_->Add(name, std::make_shared<fcl::Convexd>(points, static_cast<int>(triangles.size()), faces),
+                Eigen::Isometry3d::Identity());
+}
+
+double CollisionEnvironment::DistanceTo(int index, const Eigen::Vector3d& point) const {
+  const fcl::CollisionObjectd probe(std::make_shared<fcl::Sphered>(1e-9), Eigen::Matrix3d::Identity(), point);
+  fcl::DistanceRequestd request;
+  request.gjk_solver_type = fcl::GST_INDEP;
+  fcl::DistanceResultd result;
+  const double d = fcl::distance(objects_->objects.at(static_cast<size_t>(index)).get(), &probe, request, result);
+  return std::max(0.0, d);
+}
+
 void CollisionEnvironment::AddGround(const std::string& name, double height) {
   // A thick slab rather than an FCL half-space: every shape pair has a distance query with a box.
   constexpr double kExtent = 200.0, kDepth = 1.0;

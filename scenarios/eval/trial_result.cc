@@ -113,6 +113,10 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"estimates", t.estimates}};
   if (t.min_clearance_m) j["min_clearance_m"] = *t.min_clearance_m;
   if (!t.bush_frames.empty()) j["bush_frames"] = t.bush_frames;
+  if (!t.arm_goals.empty()) {
+    j["arm_goals"] = t.arm_goals;
+    j["arm_contacts"] = t.arm_contacts;
+  }
 }
 
 void from_json(const nlohmann::json& j, TrialResult& t) {
@@ -136,6 +140,10 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   j.at("estimates").get_to(t.estimates);
   if (j.contains("min_clearance_m")) t.min_clearance_m = j.at("min_clearance_m").get<double>();
   if (j.contains("bush_frames")) j.at("bush_frames").get_to(t.bush_frames);
+  if (j.contains("arm_goals")) {
+    j.at("arm_goals").get_to(t.arm_goals);
+    j.at("arm_contacts").get_to(t.arm_contacts);
+  }
 }
 
 void to_json(nlohmann::json& j, const CriterionResult& c) {
@@ -207,6 +215,42 @@ void AddBushMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metr
   }
 }
 
+// Metrics of arm_reach goals (see ComputeBatchMetrics).
+void AddArmMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
+  std::vector<double> position, orientation, path, cutter_path;
+  int goals = 0, reached = 0, contacts = 0;
+  double tracking = 0.0;
+  std::optional<double> clearance;
+  for (const TrialResult& trial : trials) {
+    contacts += trial.arm_contacts;
+    for (const ArmGoalOutcome& goal : trial.arm_goals) {
+      ++goals;
+      reached += goal.reached ? 1 : 0;
+      tracking = std::max(tracking, goal.tracking_error_max_rad);
+      if (goal.min_clearance_m >= 0.0) clearance = std::min(clearance.value_or(goal.min_clearance_m), goal.min_clearance_m);
+      if (!goal.stack_reached) continue;
+      position.push_back(goal.position_error_m);
+      orientation.push_back(goal.orientation_error_deg);
+      path.push_back(goal.path_length_rad);
+      cutter_path.push_back(goal.cutter_path_length_m);
+    }
+  }
+  if (goals == 0) return;
+  metrics["arm_goals"] = goals;
+  metrics["arm_success_rate"] = static_cast<double>(reached) / goals;
+  metrics["arm_contacts"] = contacts;
+  metrics["arm_tracking_error_max_rad"] = tracking;
+  if (clearance) metrics["arm_min_clearance_m"] = *clearance;
+  if (position.empty()) return;
+  const ErrorStats p = ErrorStats::From(position), o = ErrorStats::From(orientation);
+  metrics["arm_position_error_mean_m"] = p.mean;
+  metrics["arm_position_error_max_m"] = p.max;
+  metrics["arm_orientation_error_mean_deg"] = o.mean;
+  metrics["arm_orientation_error_max_deg"] = o.max;
+  metrics["arm_path_length_mean_rad"] = ErrorStats::From(path).mean;
+  metrics["arm_cutter_path_length_mean_m"] = ErrorStats::From(cutter_path).mean;
+}
+
 }  // namespace
 
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned) {
@@ -267,6 +311,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
     metrics[name + "_heading_error_max_deg"] = heading.max;
   }
   AddBushMetrics(trials, metrics);
+  AddArmMetrics(trials, metrics);
   return metrics;
 }
 

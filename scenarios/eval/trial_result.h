@@ -56,6 +56,31 @@ struct BushFrame {
   double bearing_error_deg = 0.0;
 };
 
+// One goal of an arm_reach trial: what the stack reported and the truth (cutter pose in base_link
+// from the simulator, MuJoCo's contacts, the arm's clearance from the garden as it collides).
+struct ArmGoalOutcome {
+  int goal = 0;
+  double x = 0.0, y = 0.0, z = 0.0;     // the goal's cutter position, base_link
+  bool reached = false;                 // the stack reported it reached, the true errors within tolerance, no contact
+  bool stack_reached = false;           // the stack reported it reached
+  std::string failure;                  // the stack's reason when it did not
+  double position_error_m = -1.0;       // true cutter - goal when the stack finished the goal
+  double orientation_error_deg = -1.0;
+  double witness_clearance_m = 0.0;     // of the generator's joint configuration for the pose
+  int ik_solutions = 0;
+  int free_goals = 0;                   // collision-free solutions, as the stack perceived its surroundings
+  double path_length_rad = 0.0;
+  double cutter_path_length_m = 0.0;
+  double motion_seconds = 0.0;
+  double tracking_error_max_rad = 0.0;  // true joints against the commanded targets, over the motion
+  double min_clearance_m = -1.0;        // true, while working on this goal (-1: not sampled)
+  int contacts = 0;                     // arm contact events while working on this goal
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ArmGoalOutcome, goal, x, y, z, reached, stack_reached, failure, position_error_m,
+                                   orientation_error_deg, witness_clearance_m, ik_solutions, free_goals,
+                                   path_length_rad, cutter_path_length_m, motion_seconds, tracking_error_max_rad,
+                                   min_clearance_m, contacts)
+
 struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
@@ -80,6 +105,9 @@ struct TrialResult {
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
   std::vector<BushFrame> bush_frames;  // bush goals' sightings
+  std::vector<ArmGoalOutcome> arm_goals;  // arm_reach trials
+  int arm_contacts = 0;                   // arm contact events (MuJoCo), all goals
+  std::vector<double> arm_planning_seconds;  // wall clock per plan: timing.json only, not reproducible
 };
 
 // One pass criterion of the scenario, e.g. success_rate >= 1.0.
@@ -124,7 +152,10 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 // with bush goals: bush_goals, bush_{distance,bearing}_error_{mean,max} (final pose, absolute,
 // m / deg), bush_estimate_{distance,bearing}_error_{mean,max} (the stack's final estimate), and
 // over the frames at 1-3 m: bush_frames_1_3m, bush_frame_found_rate, bush_frame_{distance,
-// bearing}_error_{mean,max}, bush_frame_within_rate (within 5 cm and 3 deg).
+// bearing}_error_{mean,max}, bush_frame_within_rate (within 5 cm and 3 deg); with arm goals:
+// arm_goals, arm_success_rate, arm_contacts, arm_position_error_{mean,max}_m,
+// arm_orientation_error_{mean,max}_deg (goals the stack reported reached), arm_tracking_error_max_rad,
+// arm_min_clearance_m, arm_path_length_mean_rad, arm_cutter_path_length_mean_m.
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);
 
 }  // namespace trimbot::scenarios

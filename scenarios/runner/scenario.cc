@@ -100,7 +100,7 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     map.RejectUnknownKeys();
   }
   if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"));
-  for (const YamlMap& goal : root.MapList("goals")) {
+  for (const YamlMap& goal : root.Has("goals") || !root.Has("arm_reach") ? root.MapList("goals") : std::vector<YamlMap>{}) {
     ScenarioGoal g;
     if (goal.Has("approach_bush")) {
       g.bush = goal.Integer("approach_bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
@@ -110,7 +110,26 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     goal.RejectUnknownKeys();
     s.goals.push_back(g);
   }
-  if (s.goals.empty()) root.Fail("goals", "needs at least one goal");
+  if (root.Has("arm_reach")) {
+    const YamlMap spec = root.Map("arm_reach");
+    ArmReach a;
+    a.bush = spec.Integer("bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
+    a.poses = spec.Integer("poses", 1, 10000);
+    a.distance_min = spec.NumberOr("distance_min", a.distance_min, 0.0, 2.0, "m");
+    a.distance_max = spec.NumberOr("distance_max", a.distance_max, 0.0, 2.0, "m");
+    if (a.distance_max <= a.distance_min) spec.Fail("distance_max", "must exceed distance_min");
+    a.max_tilt = spec.NumberOr("max_tilt_deg", a.max_tilt * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
+    a.min_clearance = spec.NumberOr("min_clearance", a.min_clearance, 0.0, 1.0, "m");
+    a.position_tolerance = spec.NumberOr("position_tolerance", a.position_tolerance, 1e-5, 1.0, "m");
+    a.orientation_tolerance =
+        spec.NumberOr("orientation_tolerance_deg", a.orientation_tolerance * 180.0 / M_PI, 1e-3, 180.0, "deg") * M_PI / 180.0;
+    if (spec.Has("renders")) a.renders = spec.Integer("renders", 0, 1000);
+    spec.RejectUnknownKeys();
+    s.arm_reach = a;
+    if (!s.goals.empty()) root.Fail("goals", "an arm_reach scenario has no navigation goals (the base stands)");
+  } else if (s.goals.empty()) {
+    root.Fail("goals", "needs at least one goal");
+  }
   s.goal_tolerance = root.NumberOr("goal_tolerance", s.goal_tolerance, 1e-3, 10.0, "m");
   if (root.Has("bush_tolerance")) {
     const YamlMap tolerance = root.Map("bush_tolerance");
@@ -179,6 +198,9 @@ bool IsKnownMetric(const std::string& name) {
                                    "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate",
                                    "min_clearance_m"};
     names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
+    names.insert({"arm_goals", "arm_success_rate", "arm_contacts", "arm_tracking_error_max_rad", "arm_min_clearance_m",
+                  "arm_position_error_mean_m", "arm_position_error_max_m", "arm_orientation_error_mean_deg",
+                  "arm_orientation_error_max_deg", "arm_path_length_mean_rad", "arm_cutter_path_length_mean_m"});
     for (const char* bush : {"bush_distance_error", "bush_bearing_error", "bush_estimate_distance_error",
                              "bush_estimate_bearing_error", "bush_frame_distance_error", "bush_frame_bearing_error"}) {
       names.insert(std::string(bush) + "_mean");

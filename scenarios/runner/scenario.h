@@ -53,6 +53,24 @@ struct ScenarioGoal {
   int bush = 0;                                          // the garden object's id; 0: a point goal
 };
 
+// An arm_reach scenario (`arm_reach:`): the base stands at the start; the arm reaches `poses`
+// random cutter poses around a bush, each reachable without collision (a witness configuration of
+// the joints has this clearance from the garden as the simulator collides with it and the ground,
+// and touches neither the arm itself nor the robot), the cutter's tip within the distance band from
+// the bush's collision surface and its axis within max_tilt of pointing at the bush's centre.
+// Judged on the true cutter pose in base_link against the goal.
+struct ArmReach {
+  int bush = 0;                       // garden object id (a topiary or rose)
+  int poses = 10;
+  double distance_min = 0.08;         // m
+  double distance_max = 0.20;         // m
+  double max_tilt = 60.0 * M_PI / 180.0;  // rad
+  double min_clearance = 0.08;        // m, of the witness configuration (the stack keeps ~4 cm off what it sees)
+  double position_tolerance = 0.01;   // m
+  double orientation_tolerance = 2.0 * M_PI / 180.0;  // rad
+  int renders = 3;                    // PNGs of the first poses reached
+};
+
 struct Scenario {
   std::string source;       // file it was read from
   std::string name;
@@ -61,7 +79,8 @@ struct Scenario {
   double map_resolution = 0.05;        // m: the robot's prior map, made from the surveyed garden
   double map_clearance_height = 1.0;   // m: objects whose lowest point is higher are not obstacles
   Survey survey;
-  std::vector<ScenarioGoal> goals;     // in order
+  std::vector<ScenarioGoal> goals;     // in order (none in an arm_reach scenario)
+  std::optional<ArmReach> arm_reach;
   double goal_tolerance = 0.3;         // m: a goal counts as reached within this (ground truth)
   // A bush goal counts as reached when the arm's axis stands within these of the standoff
   // distance and bearing the stack aimed at (ground truth).

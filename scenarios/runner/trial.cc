@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "eval/arm_reach.h"
 #include "eval/simulated_pose_fixes.h"
 #include "eval/trial_evaluator.h"
 #include "runner/closed_loop.h"
@@ -45,8 +46,10 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   return config;
 }
 
-void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t) {
+void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t,
+                 const std::vector<double>& arm_planning_seconds) {
   nlohmann::json timing = ToJson(run);
+  if (!arm_planning_seconds.empty()) timing["arm_planning_seconds"] = arm_planning_seconds;
   WriteRunTimingChart(dir + "/timing.png", "where the trial's time went", run);
   if (!t.visual_frames.empty()) {
     timing["visual_localization"] = LocalizationTimeStats(t.visual_frames);
@@ -56,10 +59,72 @@ void WriteTiming(const std::string& dir, const RunTiming& run, const stack::Stac
   WriteFileAtomically(dir + "/timing.json", timing.dump(2));
 }
 
+// An arm_reach trial: the base stands at the start while the arm reaches the generated cutter poses.
+TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(double)>& progress) {
+  const Scenario& scenario = *setup.scenario;
+  const ArmReach& spec = *scenario.arm_reach;
+  const auto wall_start = std::chrono::steady_clock::now();
+  TrialResult result;
+  result.index = setup.index;
+  result.seed = setup.seed;
+  robot::RobotFiles files = setup.paths.robot_files();
+  files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
+  const stack::StackParameters parameters = StackParametersFor(scenario, setup.paths);
+  sim::Simulator simulator(PlantFor(setup, /*render_for_stack=*/true));
+  const Eigen::Isometry3d T_map_base = simulator.ground_truth().T_map_base;
+  ArmWorld world = MakeArmWorld(scenario, simulator, T_map_base);
+  const std::vector<ArmReachPose> poses = GenerateArmReachPoses(scenario, world, simulator.robot(), T_map_base, setup.seed);
+
+  stack::RobotStack robot(files, parameters, setup.seed);
+  robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
+  std::vector<Eigen::Isometry3d> goals;
+  for (const ArmReachPose& pose : poses) goals.push_back(pose.cutter_base);
+  robot.SetArmGoals(goals);
+  // A view across the robot and the bush at the first poses reached.
+  int rendered = 0;
+  const Eigen::Vector3d across = world.bush_centre - T_map_base.translation();
+  const double view_azimuth = std::atan2(across.y(), across.x()) * 180.0 / M_PI + 90.0;
+  const auto render = [&](int goal) {
+    if (rendered >= spec.renders) return;
+    ++rendered;
+    const Eigen::Vector3d lookat = 0.5 * (T_map_base.translation() + world.bush_centre) + Eigen::Vector3d(0, 0, 0.3);
+    char name[32];
+    std::snprintf(name, sizeof(name), "/arm_pose_%02d.png", goal);
+    WritePng(setup.dir + name, simulator.RenderExternalView(lookat, 2.6, view_azimuth, -20.0, 800, 600), true);
+  };
+  ArmReachEvaluator evaluator(spec, poses, &world, render);
+  StackController controller(robot);
+  LoopOptions options;
+  options.time_limit = scenario.time_limit;
+  options.render_on_demand = true;
+  options.progress = progress;
+  const auto loop_start = std::chrono::steady_clock::now();
+  const bool finished = RunClosedLoop(simulator, controller, {&evaluator}, options);
+  result.status = finished ? "completed" : "timeout";
+  if (!finished) result.message = "time limit of " + std::to_string(scenario.time_limit) + " s reached";
+  result.simulated_seconds = simulator.time();
+  evaluator.Finish(&result);
+  const auto report_start = std::chrono::steady_clock::now();
+  evaluator.WriteFiles(setup.dir);
+  WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
+  const auto seconds = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
+  const auto now = std::chrono::steady_clock::now();
+  result.wall_seconds = seconds(wall_start, now);
+  const RunTiming run = MakeRunTiming(result.wall_seconds, result.simulated_seconds, simulator.timings(),
+                                      &robot.telemetry().timings, seconds(wall_start, loop_start),
+                                      seconds(report_start, now));
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result.arm_planning_seconds);
+  return result;
+}
+
 }  // namespace
 
 TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>& progress) {
   const Scenario& scenario = *setup.scenario;
+  if (scenario.arm_reach) {
+    std::filesystem::create_directories(setup.dir);
+    return RunArmReachTrial(setup, progress);
+  }
   const auto wall_start = std::chrono::steady_clock::now();
   std::filesystem::create_directories(setup.dir);
   TrialResult result;
@@ -115,7 +180,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   const RunTiming run = MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(),
                                       &robot.telemetry().timings, seconds(wall_start, loop_start),
                                       seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings);
+  WriteTiming(setup.dir, run, robot.telemetry().timings, {});
   return result;
 }
 

@@ -272,4 +272,33 @@ RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_
   return view;
 }
 
+cv::Mat RingRenderer::RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth,
+                                         double elevation, int width, int height) {
+  const mjModel* m = world_.model();
+  width = std::min(width, m->vis.global.offwidth);
+  height = std::min(height, m->vis.global.offheight);
+  if (OSMesaGetCurrentContext() != gl_->context &&
+      !OSMesaMakeCurrent(gl_->context, gl_->buffer.data(), GL_UNSIGNED_BYTE, m->vis.global.offwidth,
+                         m->vis.global.offheight)) {
+    throw std::runtime_error("OSMesa: cannot make the context current");
+  }
+  mjvCamera view;
+  mjv_defaultCamera(&view);
+  view.type = mjCAMERA_FREE;
+  for (int i = 0; i < 3; ++i) view.lookat[i] = lookat[i];
+  view.distance = distance;
+  view.azimuth = azimuth;
+  view.elevation = elevation;
+  mjv_updateScene(m, world_.data(), &gl_->option, nullptr, &view, mjCAT_ALL, &gl_->scene);
+  gl_->scene.flags[mjRND_SEGMENT] = 0;
+  gl_->scene.flags[mjRND_IDCOLOR] = 0;
+  const mjrRect viewport = {0, 0, width, height};
+  mjr_render(viewport, &gl_->scene, &gl_->render_context);
+  glFinish();
+  mjr_readPixels(gl_->rgb.data(), nullptr, viewport, &gl_->render_context);
+  cv::Mat rgb;
+  cv::flip(cv::Mat(height, width, CV_8UC3, gl_->rgb.data()), rgb, 0);  // OpenGL rows start at the bottom
+  return rgb;
+}
+
 }  // namespace trimbot::sim

@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <chrono>
+#include <map>
 #include <cmath>
 
 #include "trimbot/common/input_error.h"
@@ -394,6 +395,57 @@ std::vector<ArmContact> Simulator::ArmContacts() const {
     contacts.push_back({mj_id2name(m, mjOBJ_GEOM, arm), mj_id2name(m, mjOBJ_GEOM, other), -contact.dist});
   }
   return contacts;
+}
+
+cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth,
+                                      double elevation, int width, int height) {
+  if (!impl_->renderer) throw std::logic_error("RenderExternalView: the simulator was configured without cameras");
+  mj_forward(impl_->world->model(), impl_->world->data());
+  return impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);
+}
+
+std::vector<CollisionHull> Simulator::GardenCollisionHulls() const {
+  const World& world = *impl_->world;
+  const mjModel* m = world.model();
+  const mjData* d = world.data();
+  std::vector<CollisionHull> hulls;
+  for (int g = 0; g < m->ngeom; ++g) {
+    const GeomLabel* label = world.label(g);
+    if (label == nullptr || label->is_ground || label->object_class == garden::ObjectClass::kRobot) continue;
+    if (m->geom_type[g] != mjGEOM_MESH || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;
+    const int mesh = m->geom_dataid[g];
+    const int graph_address = m->mesh_graphadr[mesh];
+    if (graph_address < 0) continue;  // MuJoCo made no hull: the mesh does not collide
+    // mesh_graph: numvert, numface, vert_edgeadr[numvert], vert_globalid[numvert],
+    // edge_localid[numvert + 3 numface], face_globalid[3 numface] (MuJoCo's convex hull).
+    const int* graph = m->mesh_graph + graph_address;
+    const int vertices = graph[0], faces = graph[1];
+    const int* face_global = graph + 2 + 3 * vertices + 3 * faces;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() << d->geom_xpos[3 * g], d->geom_xpos[3 * g + 1], d->geom_xpos[3 * g + 2];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) pose.linear()(r, c) = d->geom_xmat[9 * g + 3 * r + c];
+    }
+    CollisionHull hull;
+    hull.geom = label->geom_name;
+    hull.object_id = label->object_id;
+    hull.object_class = label->object_class;
+    // Only the hull's own vertices, the faces renumbered to them.
+    const int* vertex_global = graph + 2 + vertices;
+    const float* vertex = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
+    std::map<int, int> local;
+    for (int v = 0; v < vertices; ++v) {
+      const int id = vertex_global[v];
+      local[id] = v;
+      hull.vertices.push_back(pose * Eigen::Vector3d(vertex[3 * id], vertex[3 * id + 1], vertex[3 * id + 2]));
+    }
+    for (int f = 0; f < faces; ++f) {
+      hull.triangles.push_back(
+          {local.at(face_global[3 * f]), local.at(face_global[3 * f + 1]), local.at(face_global[3 * f + 2])});
+    }
+    hulls.push_back(std::move(hull));
+  }
+  return hulls;
 }
 
 }  // namespace trimbot::sim

@@ -167,6 +167,11 @@ struct ArmPlanner::Ompl {
     }
     space->enforceBounds(state);
   }
+  ob::ScopedState<> Scoped(const Eigen::VectorXd& q) const {
+    ob::ScopedState<> state(space);
+    FromVector(q, state.get());
+    return state;
+  }
 };
 
 ArmPlanner::ArmPlanner(const ArmKinematics& kinematics, const robot::CollisionModel& collision,
@@ -232,7 +237,8 @@ ArmPlan ArmPlanner::Plan(const Eigen::VectorXd& start, const std::vector<Eigen::
     finish(&plan);
     return plan;
   }
-  auto goal_states = std::make_shared<ob::GoalStates>(ompl_->si);
+  // The collision-free solutions, nearest to the start first (the joints' travel, the short way round).
+  std::vector<std::pair<double, Eigen::VectorXd>> free;
   robot::CollisionReport blocked;
   for (const Eigen::VectorXd& q : goals) {
     const robot::CollisionReport report = collision_.Check(q);
@@ -240,19 +246,26 @@ ArmPlan ArmPlanner::Plan(const Eigen::VectorXd& start, const std::vector<Eigen::
       blocked = report;
       continue;
     }
-    ob::ScopedState<> state(ompl_->space);
-    ompl_->FromVector(q, state.get());
-    goal_states->addState(state);
-    ++plan.free_goals;
+    free.emplace_back(ompl_->space->distance(ompl_->Scoped(start).get(), ompl_->Scoped(q).get()), q);
   }
-  if (plan.free_goals == 0) {
+  plan.free_goals = static_cast<int>(free.size());
+  if (free.empty()) {
     plan.failure = "all " + std::to_string(goals.size()) + " joint solutions collide (e.g. " + blocked.pair.first +
                    " - " + blocked.pair.second + ")";
     finish(&plan);
     return plan;
   }
-  ob::ScopedState<> from(ompl_->space);
-  ompl_->FromVector(start, from.get());
+  std::stable_sort(free.begin(), free.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  const ob::ScopedState<> from = ompl_->Scoped(start);
+  // A straight joint-space motion to a solution, when one is free, is the shortest path there.
+  for (const auto& [distance, q] : free) {
+    if (!ompl_->si->checkMotion(from.get(), ompl_->Scoped(q).get())) continue;
+    SetWaypoints(start, {q}, &plan);
+    finish(&plan);
+    return plan;
+  }
+  auto goal_states = std::make_shared<ob::GoalStates>(ompl_->si);
+  for (const auto& [distance, q] : free) goal_states->addState(ompl_->Scoped(q));
   auto problem = std::make_shared<ob::ProblemDefinition>(ompl_->si);
   problem->addStartState(from);
   problem->setGoal(goal_states);
@@ -277,22 +290,27 @@ ArmPlan ArmPlanner::Plan(const Eigen::VectorXd& start, const std::vector<Eigen::
   }
   og::PathGeometric path = *problem->getSolutionPath()->as<og::PathGeometric>();
   og::PathSimplifier simplifier(ompl_->si);
-  simplifier.reduceVertices(path);
-  simplifier.shortcutPath(path);
-  // Unwrapped from the start's own joint values, each continuous joint the short way round.
-  plan.waypoints.push_back(start);
-  for (size_t k = 1; k < path.getStateCount(); ++k) {
-    const Eigen::VectorXd raw = ompl_->ToVector(path.getState(k));
-    Eigen::VectorXd q = raw;
-    for (int i = 0; i < q.size(); ++i) {
-      if (ompl_->continuous[static_cast<size_t>(i)]) q(i) = plan.waypoints.back()(i) + Wrap(raw(i) - plan.waypoints.back()(i));
-    }
-    plan.waypoints.push_back(q);
-  }
-  plan.trajectory = TimeParameterize(plan.waypoints, VelocityLimits(), parameters_.acceleration);
-  Finish(&plan);
+  simplifier.simplifyMax(path);
+  std::vector<Eigen::VectorXd> states;
+  for (size_t k = 1; k < path.getStateCount(); ++k) states.push_back(ompl_->ToVector(path.getState(k)));
+  SetWaypoints(start, states, &plan);
   finish(&plan);
   return plan;
+}
+
+void ArmPlanner::SetWaypoints(const Eigen::VectorXd& start, const std::vector<Eigen::VectorXd>& states,
+                              ArmPlan* plan) const {
+  // Unwrapped from the start's own joint values, each continuous joint the short way round.
+  plan->waypoints = {start};
+  for (const Eigen::VectorXd& raw : states) {
+    Eigen::VectorXd q = raw;
+    for (int i = 0; i < q.size(); ++i) {
+      if (ompl_->continuous[static_cast<size_t>(i)]) q(i) = plan->waypoints.back()(i) + Wrap(raw(i) - plan->waypoints.back()(i));
+    }
+    plan->waypoints.push_back(q);
+  }
+  plan->trajectory = TimeParameterize(plan->waypoints, VelocityLimits(), parameters_.acceleration);
+  Finish(plan);
 }
 
 Eigen::VectorXd ArmPlanner::VelocityLimits() const {

@@ -39,6 +39,10 @@ class CollisionEnvironment {
   // A triangle mesh (vertices in the mesh's frame, posed by `pose`).
   void AddMesh(const std::string& name, const std::vector<Eigen::Vector3d>& vertices,
                const std::vector<std::array<int, 3>>& triangles, const Eigen::Isometry3d& pose);
+  // A solid convex polyhedron (vertices in this frame; faces outward-oriented triangles), e.g. the
+  // convex hull a physics engine collides a mesh with.
+  void AddConvex(const std::string& name, const std::vector<Eigen::Vector3d>& vertices,
+                 const std::vector<std::array<int, 3>>& triangles);
   // Everything at or below z = height: the ground.
   void AddGround(const std::string& name, double height);
   // Occupied space seen as points (a perceived cloud): an octree of cubes of edge `resolution`, each
@@ -47,6 +51,8 @@ class CollisionEnvironment {
 
   int size() const;
   const std::string& name(int index) const;
+  // Distance from a point to object `index` (0 when the point is inside a solid or touches it).
+  double DistanceTo(int index, const Eigen::Vector3d& point) const;
 
  private:
   friend class CollisionModel;

@@ -41,6 +41,10 @@ class RingRenderer {
   // world's current state (call mj_forward first).
   RenderedView Render(int index, double resolution_scale, bool with_ground_truth);
   const RenderTimings& timings() const { return timings_; }
+  // A view from outside the robot (for reports): a free camera `distance` m from `lookat`, at
+  // `azimuth` and `elevation` (deg, MuJoCo's convention), RGB, upright, at most the offscreen size.
+  cv::Mat RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
+                             int width, int height);
 
  private:
   struct CameraSetup {

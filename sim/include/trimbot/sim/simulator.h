@@ -82,6 +82,15 @@ struct ArmContact {
   double penetration = 0.0;  // m
 };
 
+// The convex hull MuJoCo collides with for one garden geom, in the world frame.
+struct CollisionHull {
+  std::string geom;
+  int object_id = 0;
+  garden::ObjectClass object_class = garden::ObjectClass::kNone;
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> triangles;
+};
+
 // The renderer's truth about one ring frame.
 struct RingTruth {
   std::vector<RenderedView> views;              // depth/labels on ground-truth frames, else empty
@@ -157,6 +166,11 @@ class Simulator {
   // images; RingTruth's views of the others are empty).
   RingCapture CaptureRing(bool with_ground_truth);
   RingCapture CaptureRing(const messages::RingRequest& request, bool with_ground_truth);
+  // A view of the world now from outside the robot (RingRenderer::RenderExternalView).
+  cv::Mat RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
+                             int width, int height);
+  // What MuJoCo collides with for each garden object (meshes: their convex hulls), in the world frame.
+  std::vector<CollisionHull> GardenCollisionHulls() const;
   // Every camera at the configured resolution (what the camera schedule renders).
   messages::RingRequest WholeRing() const;
   // Where the wall-clock time went since the start.

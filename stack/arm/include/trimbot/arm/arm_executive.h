@@ -26,14 +26,14 @@ namespace trimbot::arm {
 
 struct ArmExecutiveParameters {
   ArmPlannerParameters planner;
-  double cell = 0.03;              // m: octree cell of the perceived points
-  double margin = 0.03;            // m: cells are grown by this (stereo noise, tracking error)
+  double cell = 0.02;              // m: octree cell of the perceived points
+  double margin = 0.02;            // m: cells are grown by this (stereo noise)
   int min_points_per_cell = 2;     // fewer: a stray match, not a surface
   double max_point_sigma = 0.05;   // m: points less certain than this along their worst axis are dropped
   double reach = 1.3;              // m from the arm's base: farther points cannot be hit
   double ground_clearance = 0.02;  // m: the ground plane the arm must stay above; points below 2x it are ground
   double body_margin = 0.05;       // m: points within the base's outline grown by this are the robot itself
-  double settle_tolerance = 0.01;  // rad: every joint within this of the trajectory's end
+  double settle_tolerance = 0.002; // rad: every joint within this of the trajectory's end
   double settle_timeout = 3.0;     // s after the trajectory's end
 };
 

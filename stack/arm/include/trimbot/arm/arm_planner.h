@@ -78,6 +78,8 @@ class ArmPlanner {
 
  private:
   ArmPlan Plan(const Eigen::VectorXd& start, const std::vector<Eigen::VectorXd>& goals, ArmPlan plan);
+  // The plan's waypoints (start, then `states` unwrapped from it), trajectory and lengths.
+  void SetWaypoints(const Eigen::VectorXd& start, const std::vector<Eigen::VectorXd>& states, ArmPlan* plan) const;
   // Marks a plan with its trajectory done: its lengths.
   void Finish(ArmPlan* plan) const;
   Eigen::VectorXd VelocityLimits() const;  // rad/s: the URDF's, scaled
