@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -155,6 +156,33 @@ TEST(ArmKinematics, InverseKinematicsFindsTheBranchThePoseCameFrom) {
   EXPECT_GE(solved, 0.99 * poses);
   EXPECT_GE(branch_found, 0.99 * poses);
   EXPECT_GT(branches / std::max(1, solved), 1.5) << "an offset-wrist 6R arm has several branches per pose";
+}
+
+// Every branch: the default seeding (pre-computed poses nearest the target, a few spread starts)
+// finds every distinct solution that LM from 1024 starts spread densely over joint space finds.
+TEST(ArmKinematics, InverseKinematicsFindsEveryBranchDenseSeedingFinds) {
+  const ArmKinematics arm(robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf")));
+  Configurations configurations(arm);
+  IkOptions dense;
+  dense.database_seeds = 0;
+  dense.starts = 1024;
+  int branches = 0, missed = 0;
+  for (int n = 0; n < 40; ++n) {
+    const Eigen::Isometry3d target = arm.EndEffectorPose(configurations.Next());
+    const IkResult found = arm.InverseKinematics(target);
+    for (const Eigen::VectorXd& s : arm.InverseKinematics(target, dense).solutions) {
+      ++branches;
+      const bool known = std::any_of(found.solutions.begin(), found.solutions.end(), [&](const Eigen::VectorXd& t) {
+        Eigen::VectorXd d = s - t;
+        for (int i = 0; i < 6; ++i) d(i) = std::remainder(d(i), 2.0 * M_PI);
+        return d.cwiseAbs().maxCoeff() < 1e-3;
+      });
+      if (!known) ++missed;
+    }
+  }
+  RecordProperty("branches", branches);
+  EXPECT_GT(branches, 150);
+  EXPECT_EQ(missed, 0);
 }
 
 // A pose out of reach fails with the reason, in bounded time.

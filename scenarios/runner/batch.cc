@@ -346,6 +346,7 @@ int RunBatch(const BatchOptions& options) {
   StackParametersFor(scenario, options.paths);
   const garden::OccupancyMap map = PriorMap(scenario, options.paths);
   const std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
+  CheckArmReach(scenario, options.paths);
   const std::vector<GoalTruth> true_goals = GoalTruths(scenario, options.paths);
   const std::string& out = options.out_dir;
   BatchInfo info;

@@ -63,19 +63,22 @@ std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& di
 
 namespace {
 
-const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const Scenario& scenario) {
+// `what`: where the id was given ("goals: approach_bush 3"), for the error.
+const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const Scenario& scenario,
+                                   const std::string& what) {
   const auto it = std::find_if(garden.objects.begin(), garden.objects.end(),
                                [id](const garden::GardenObject& o) { return o.id == id; });
   if (it == garden.objects.end()) {
-    throw InputError(scenario.source, "goals: approach_bush " + std::to_string(id) + ": the garden '" + garden.name +
-                                          "' as surveyed has no object " + std::to_string(id));
+    throw InputError(scenario.source, what + ": the garden '" + garden.name + "' has no object " + std::to_string(id));
   }
   if (it->object_class != garden::ObjectClass::kTopiary && it->object_class != garden::ObjectClass::kRose) {
-    throw InputError(scenario.source, "goals: approach_bush " + std::to_string(id) + ": object " + std::to_string(id) +
-                                          " is a " + garden::ToString(it->object_class) + ", not a bush (topiary or rose)");
+    throw InputError(scenario.source, what + ": object " + std::to_string(id) + " is a " +
+                                          garden::ToString(it->object_class) + ", not a bush (topiary or rose)");
   }
   return *it;
 }
+
+std::string ApproachBush(int id) { return "goals: approach_bush " + std::to_string(id); }
 
 perception::BushShape ShapeOf(const garden::GardenObject& object) {
   perception::BushShape shape;
@@ -99,17 +102,23 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPat
       goals.emplace_back(goal.position);
       continue;
     }
-    const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario);
+    const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario, ApproachBush(goal.bush));
     goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
   }
   return goals;
+}
+
+void CheckArmReach(const Scenario& scenario, const ProjectPaths& paths) {
+  if (!scenario.arm_reach) return;
+  const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  BushOf(world, scenario.arm_reach->bush, scenario, "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
 }
 
 std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const ProjectPaths& paths) {
   const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
   std::vector<GoalTruth> truths;
   for (const ScenarioGoal& goal : scenario.goals) {
-    truths.push_back({goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario).position, goal.bush});
+    truths.push_back({goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario, ApproachBush(goal.bush)).position, goal.bush});
   }
   return truths;
 }

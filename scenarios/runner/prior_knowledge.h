@@ -33,6 +33,8 @@ std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& di
 // (centre, shape, yaw). Throws InputError naming the scenario for a bush the surveyed garden lacks
 // or an object that is not a bush (topiary or rose).
 std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPaths& paths);
+// An arm_reach scenario's bush is a bush of the garden; InputError naming the scenario otherwise.
+void CheckArmReach(const Scenario& scenario, const ProjectPaths& paths);
 // Where each goal truly is, for the evaluation: a point goal's position, a bush's true centre in
 // the world (the garden file's object), with the bush's id.
 std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const ProjectPaths& paths);

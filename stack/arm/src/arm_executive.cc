@@ -42,6 +42,7 @@ ArmExecutive::~ArmExecutive() = default;
 void ArmExecutive::SetGoals(const std::vector<Eigen::Isometry3d>& cutter_poses) {
   goals_ = cutter_poses;
   goal_ = 0;
+  if (!goals_.empty()) kinematics_.PrepareDatabase(parameters_.planner.ik);  // not inside the first plan
   mode_ = goals_.empty() ? Mode::kDone : Mode::kWaitingForEnvironment;
 }
 

@@ -6,10 +6,13 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -55,13 +58,40 @@ double Halton(int index, int base) {
   return result;
 }
 
+// A pose as a point for nearest-neighbour search: the position and two axes of the orientation
+// scaled so that 1 rad weighs like 0.15 m.
+constexpr double kOrientationWeight = 0.15;
+std::array<double, 9> PoseFeature(const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d& p = pose.translation();
+  const Eigen::Vector3d x = kOrientationWeight * pose.linear().col(0), z = kOrientationWeight * pose.linear().col(2);
+  return {p.x(), p.y(), p.z(), x.x(), x.y(), x.z(), z.x(), z.y(), z.z()};
+}
+
+
 }  // namespace
+
+// Pre-computed solutions (the real robot's speed-up, D3.4 Section 1.5): joint configurations spread
+// over joint space and the cutter pose of each, searched by pose. The configurations whose poses
+// are nearest a target lie near its solutions, on every branch that reaches near it.
+struct SeedDatabase {
+  std::vector<Eigen::VectorXd> joints;
+  std::vector<std::array<double, 9>> features;
+  size_t kdtree_get_point_count() const { return features.size(); }
+  double kdtree_get_pt(size_t i, size_t d) const { return features[i][d]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box& /*box*/) const { return false; }
+};
+using SeedTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SeedDatabase>, SeedDatabase, 9>;
 
 struct ArmKinematics::Chain {
   KDL::Chain chain;
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk;
   std::unique_ptr<KDL::ChainJntToJacSolver> jacobian;
   std::unique_ptr<KDL::ChainIkSolverPos_LMA> ik;
+  // Built on the first inverse kinematics that asks for database seeds.
+  std::once_flag database_built;
+  SeedDatabase database;
+  std::unique_ptr<SeedTree> tree;
 };
 
 ArmKinematics::ArmKinematics(const robot::RobotDescription& description) : chain_(std::make_unique<Chain>()) {
@@ -157,21 +187,60 @@ bool ArmKinematics::WithinLimits(const Eigen::VectorXd& q) const {
   return true;
 }
 
-IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options) const {
+const SeedDatabase& ArmKinematics::Database(int size) const {
+  std::call_once(chain_->database_built, [&] {
+    static constexpr int kPrimes[6] = {17, 19, 23, 29, 31, 37};  // not the starts' primes
+    SeedDatabase& database = chain_->database;
+    for (int n = 0; n < size; ++n) {
+      Eigen::VectorXd q(joints());
+      for (int i = 0; i < joints(); ++i) {
+        const JointLimit& limit = limits_[static_cast<std::size_t>(i)];
+        const double u = Halton(n, kPrimes[i]);
+        q(i) = limit.continuous ? -M_PI + 2.0 * M_PI * u : limit.lower + (limit.upper - limit.lower) * u;
+      }
+      database.features.push_back(PoseFeature(EndEffectorPose(q)));
+      database.joints.push_back(std::move(q));
+    }
+    chain_->tree = std::make_unique<SeedTree>(9, database, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    chain_->tree->buildIndex();
+  });
+  return chain_->database;
+}
+
+std::vector<Eigen::VectorXd> ArmKinematics::Seeds(const Eigen::Isometry3d& target, const IkOptions& options) const {
   static constexpr int kPrimes[6] = {2, 3, 5, 7, 11, 13};
+  std::vector<Eigen::VectorXd> seeds;
+  if (options.database_seeds > 0) {
+    const SeedDatabase& database = Database(options.database_size);
+    const std::array<double, 9> query = PoseFeature(target);
+    const size_t k = std::min<size_t>(static_cast<size_t>(options.database_seeds), database.joints.size());
+    std::vector<unsigned> nearest(k);  // nanoflann's default index type
+    std::vector<double> distances(k);
+    const size_t found = chain_->tree->knnSearch(query.data(), k, nearest.data(), distances.data());
+    for (size_t n = 0; n < found; ++n) seeds.push_back(database.joints[nearest[n]]);
+  }
+  for (int start = 0; start < options.starts; ++start) {
+    Eigen::VectorXd q(joints());
+    for (int i = 0; i < joints(); ++i) {
+      const JointLimit& limit = limits_[static_cast<std::size_t>(i)];
+      const double u = Halton(start, kPrimes[i]);
+      q(i) = limit.continuous ? -M_PI + 2.0 * M_PI * u : limit.lower + (limit.upper - limit.lower) * u;
+    }
+    seeds.push_back(std::move(q));
+  }
+  return seeds;
+}
+
+IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options) const {
   KDL::ChainIkSolverPos_LMA solver(chain_->chain, 1e-12, options.max_iterations);
   const KDL::Frame goal = ToKdl(target);
   IkResult result;
   double closest_position = std::numeric_limits<double>::infinity(), closest_angle = closest_position;
   int outside_limits = 0;
-  for (int start = 0; start < options.starts; ++start) {
-    KDL::JntArray seed(static_cast<unsigned>(joints())), solution(static_cast<unsigned>(joints()));
-    for (int i = 0; i < joints(); ++i) {
-      const JointLimit& limit = limits_[static_cast<std::size_t>(i)];
-      const double u = Halton(start, kPrimes[i]);
-      seed(i) = limit.continuous ? -M_PI + 2.0 * M_PI * u : limit.lower + (limit.upper - limit.lower) * u;
-    }
-    solver.CartToJnt(seed, goal, solution);
+  const std::vector<Eigen::VectorXd> seeds = Seeds(target, options);
+  for (const Eigen::VectorXd& seed : seeds) {
+    KDL::JntArray solution(static_cast<unsigned>(joints()));
+    solver.CartToJnt(ToKdl(seed), goal, solution);
     Eigen::VectorXd q = solution.data;
     for (int i = 0; i < joints(); ++i) {
       if (limits_[static_cast<std::size_t>(i)].continuous) q(i) = -std::remainder(-q(i), 2.0 * M_PI);  // (-pi, pi]
@@ -198,10 +267,10 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
   if (result.solutions.empty()) {
     std::ostringstream why;
     if (outside_limits > 0) {
-      why << "the pose is reached only outside the joint limits (" << outside_limits << " of " << options.starts
+      why << "the pose is reached only outside the joint limits (" << outside_limits << " of " << seeds.size()
           << " starts)";
     } else {
-      why << "unreachable: the closest of " << options.starts << " starts ends " << closest_position << " m and "
+      why << "unreachable: the closest of " << seeds.size() << " starts ends " << closest_position << " m and "
           << closest_angle * 180.0 / M_PI << " deg from the pose";
     }
     result.failure = why.str();

@@ -228,7 +228,9 @@ void ReadArm(Reader& r, arm::ArmExecutiveParameters& p) {
     f.Number("acceleration", &o.acceleration, 0.01, 100.0, "rad/s^2");
     f.Number("cartesian_step", &o.cartesian_step, 1e-4, 0.1, "m");
     f.Number("cartesian_max_joint_step", &o.cartesian_max_joint_step, 1e-3, 1.0, "rad");
-    f.Integer("ik_starts", &o.ik.starts, 1, 10000);
+    f.Integer("ik_database_seeds", &o.ik.database_seeds, 0, 100000);
+    f.Integer("ik_starts", &o.ik.starts, 0, 10000);
+    if (o.ik.database_seeds + o.ik.starts == 0) f.map().Fail("ik_starts", "inverse kinematics needs seeds or starts");
   });
   r.Section("environment", [&](Reader& f) {
     f.Number("cell", &p.cell, 0.005, 0.5, "m");

@@ -3,8 +3,9 @@
 // to the cutter frame (arm_end_effector) as an Orocos KDL chain, the arm joints' limits and
 // velocity limits, forward kinematics of every link of the chain, the geometric Jacobian,
 // Yoshikawa's manipulability, and inverse kinematics returning every distinct solution of a cutter
-// pose: the j2n6s300's offset wrist has no closed form, so Levenberg-Marquardt (KDL) from a fixed
-// set of starts spread over joint space, continuous joints wrapped to (-pi, pi], solutions outside
+// pose: the j2n6s300's offset wrist has no closed form, so Levenberg-Marquardt (KDL) from the
+// nearest configurations of a database of pre-computed poses and from a fixed set of starts spread
+// over joint space, continuous joints wrapped to (-pi, pi], solutions outside
 // the limits dropped, the rest deduplicated. Angles in rad, lengths in m, poses in base_link.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -25,7 +26,11 @@ struct JointLimit {
 };
 
 struct IkOptions {
-  int starts = 48;                 // LM runs from fixed, evenly spread starts (same pose, same answer)
+  // LM runs from the database's configurations whose poses are nearest the target (pre-computed
+  // solutions, as on the real robot), then from fixed starts spread evenly over joint space.
+  int database_seeds = 96;         // with 8 starts: every branch that 1024 starts find, on 200 random poses
+  int database_size = 1 << 16;     // configurations in the database (built once, on first use)
+  int starts = 8;                  // same pose, same answer
   double position_tolerance = 1e-6;   // m
   double orientation_tolerance = 1e-6;  // rad
   int max_iterations = 300;        // per start: bounded, so an unreachable pose fails, never hangs
@@ -36,6 +41,8 @@ struct IkResult {
   std::vector<Eigen::VectorXd> solutions;  // distinct, within the limits, ordered by the first start that found them
   std::string failure;  // when none: why (unreachable by how much, or only outside the limits)
 };
+
+struct SeedDatabase;
 
 class ArmKinematics {
  public:
@@ -63,6 +70,8 @@ class ArmKinematics {
   bool WithinLimits(const Eigen::VectorXd& q) const;
   // Every distinct joint solution that puts the cutter frame at `target` (base_link).
   IkResult InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options = {}) const;
+  // Builds the database of pre-computed poses now (else the first InverseKinematics does).
+  void PrepareDatabase(const IkOptions& options = {}) const { Database(options.database_size); }
   // The solution reached from `seed` alone (the branch the arm is on, for a small step of the
   // cutter), continuous joints left near the seed's values; nullopt when it misses the pose or a limit.
   std::optional<Eigen::VectorXd> InverseKinematicsNear(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed,
@@ -70,6 +79,8 @@ class ArmKinematics {
 
  private:
   void CheckSize(const Eigen::VectorXd& q) const;
+  const SeedDatabase& Database(int size) const;
+  std::vector<Eigen::VectorXd> Seeds(const Eigen::Isometry3d& target, const IkOptions& options) const;
 
   struct Chain;
   std::unique_ptr<Chain> chain_;
