@@ -13,60 +13,8 @@ namespace {
 constexpr double kReferenceDistanceCm = 1.26;   // D3.4 Figure 20: mean over 5 trials
 constexpr double kReferenceBearingDeg = 2.08;
 
-const cv::Scalar kAxis(60, 60, 60), kGrid(225, 225, 225), kTruth(120, 120, 120), kEstimate(40, 110, 200),
-    kReached(220, 120, 40), kReference(200, 40, 40);
-
-// A panel with x and y ranges mapped onto a rectangle of the image, with a grid and labels.
-class Panel {
- public:
-  Panel(cv::Mat& image, cv::Rect area, double x0, double x1, double y0, double y1, const std::string& label)
-      : image_(image), area_(area), x0_(x0), x1_(x1 > x0 ? x1 : x0 + 1.0) {
-    const double pad = 0.08 * std::max(1e-6, y1 - y0);
-    step_ = NiceStep(y1 - y0 + 2.0 * pad, 4);
-    y0_ = std::floor((y0 >= 0.0 ? std::max(0.0, y0 - pad) : y0 - pad) / step_) * step_;  // errors stay >= 0
-    y1_ = std::ceil((y1 + pad) / step_) * step_;
-    for (double v = y0_; v <= y1_ + 1e-9 * step_; v += step_) {
-      cv::line(image_, At(x0_, v), At(x1_, v), kGrid, 1);
-      const std::string text = FormatNumber(std::round(v / step_) * step_);
-      PutText(image_, text, {area_.x - 6 - TextSize(text, 0.35, 1).width, At(x0_, v).y + 4}, 0.35, kAxis);
-    }
-    cv::rectangle(image_, area_, kAxis, 1);
-    PutText(image_, label, {area_.x + 4, area_.y - 5}, 0.4, kInk);
-  }
-  cv::Point At(double x, double y) const {
-    return {area_.x + static_cast<int>(std::lround((x - x0_) / (x1_ - x0_) * area_.width)),
-            area_.y + area_.height - static_cast<int>(std::lround((y - y0_) / (y1_ - y0_) * area_.height))};
-  }
-  void Line(const std::vector<cv::Point2d>& points, const cv::Scalar& colour, int thickness) {
-    for (std::size_t i = 1; i < points.size(); ++i) {
-      cv::line(image_, At(points[i - 1].x, points[i - 1].y), At(points[i].x, points[i].y), colour, thickness, cv::LINE_AA);
-    }
-  }
-  void Dots(const std::vector<cv::Point2d>& points, const cv::Scalar& colour) {
-    for (const auto& p : points) cv::circle(image_, At(p.x, p.y), 2, colour, cv::FILLED, cv::LINE_AA);
-  }
-  void Horizontal(double y, const cv::Scalar& colour) { cv::line(image_, At(x0_, y), At(x1_, y), colour, 1, cv::LINE_AA); }
-
- private:
-  cv::Mat& image_;
-  cv::Rect area_;
-  double x0_, x1_, y0_ = 0.0, y1_ = 1.0, step_ = 1.0;
-};
-
-void Extent(const std::vector<cv::Point2d>& points, double* x0, double* x1, double* y0, double* y1) {
-  for (const auto& p : points) {
-    *x0 = std::min(*x0, p.x), *x1 = std::max(*x1, p.x), *y0 = std::min(*y0, p.y), *y1 = std::max(*y1, p.y);
-  }
-}
-
-void Legend(cv::Mat& image, int y, const std::vector<std::pair<std::string, cv::Scalar>>& entries) {
-  int x = 20;
-  for (const auto& [text, colour] : entries) {
-    cv::line(image, {x, y - 4}, {x + 22, y - 4}, colour, 3, cv::LINE_AA);
-    PutText(image, text, {x + 28, y}, 0.42, kInk);
-    x += 48 + TextSize(text, 0.42, 1).width;
-  }
-}
+const cv::Scalar kAxis(60, 60, 60), kTruth(120, 120, 120), kEstimate(40, 110, 200), kReached(220, 120, 40),
+    kReference(200, 40, 40);
 
 }  // namespace
 

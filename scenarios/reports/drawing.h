@@ -4,6 +4,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace trimbot::scenarios {
 
@@ -26,5 +28,26 @@ void PutTextCentred(cv::Mat& image, const std::string& text, cv::Point centre, d
 cv::Point FixedPoint(const cv::Point2d& pixel);
 // 1, 2 or 5 times a power of ten, so that `range` holds about `ticks` steps.
 double NiceStep(double range, int ticks);
+
+// A panel of a plot: x and y ranges mapped onto a rectangle of the image, with a y grid, tick
+// labels and a title above it (y starts at 0 for ranges of errors, which are >= 0).
+class Panel {
+ public:
+  Panel(cv::Mat& image, cv::Rect area, double x0, double x1, double y0, double y1, const std::string& label);
+  cv::Point At(double x, double y) const;
+  void Line(const std::vector<cv::Point2d>& points, const cv::Scalar& colour, int thickness);
+  void Dots(const std::vector<cv::Point2d>& points, const cv::Scalar& colour, int radius = 2);
+  void Horizontal(double y, const cv::Scalar& colour);
+
+ private:
+  cv::Mat& image_;
+  cv::Rect area_;
+  double x0_, x1_, y0_ = 0.0, y1_ = 1.0, step_ = 1.0;
+};
+
+// Grows [x0, x1] x [y0, y1] to hold the points.
+void Extent(const std::vector<cv::Point2d>& points, double* x0, double* x1, double* y0, double* y1);
+// A row of coloured line samples with their labels, from the left edge at height y.
+void Legend(cv::Mat& image, int y, const std::vector<std::pair<std::string, cv::Scalar>>& entries);
 
 }  // namespace trimbot::scenarios

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <thread>
 
+#include "reports/arm_plot.h"
 #include "reports/bush_plot.h"
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
@@ -192,17 +193,21 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
   WriteJunitXml(out + "/junit.xml", summary);
 
   const std::optional<RunTiming> timing = WriteTiming(out, results);
-  std::vector<PlotTrajectory> trajectories;
-  for (const auto& r : results) {
-    const std::string dir = TrialDir(out, r.index);
-    if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
-    trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
+  if (scenario.arm_reach) {
+    WriteArmReachPlot(out + "/arm_reach.png", scenario.name + ": cutter poses reached (ground truth)", results);
+  } else {
+    std::vector<PlotTrajectory> trajectories;
+    for (const auto& r : results) {
+      const std::string dir = TrialDir(out, r.index);
+      if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
+      trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
+    }
+    WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, goals,
+                        scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
+    WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
+    WriteBushFramePlot(out + "/bush_frames.png", scenario.name + ": the bush from stereo per frame", results);
+    WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth", results);
   }
-  WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, goals,
-                      scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
-  WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
-  WriteBushFramePlot(out + "/bush_frames.png", scenario.name + ": the bush from stereo per frame", results);
-  WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth", results);
 
   log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
   for (const auto& r : results) log << "  " << OneLine(r) << "\n";
@@ -212,7 +217,9 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
               << " (actual " << c.actual << ")\n";
   }
   if (timing) log << "summed over the trials' processes, " << FormatRunTiming(*timing);
-  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n";
+  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, "
+      << (scenario.arm_reach ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
+                             : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");
   return summary.pass ? 0 : 1;
 }
 
