@@ -14,6 +14,51 @@ Eigen::VectorXd ToVector(const messages::ArmJointState& joints) {
 
 }  // namespace
 
+int BuildPerceivedEnvironment(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters,
+                              const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances,
+                              robot::CollisionEnvironment* environment) {
+  // The arm's base: the parent link of its first joint.
+  const std::string arm_base_link = description.urdf().getJoint(robot::RobotFrames::ArmJoint(0))->parent_link_name;
+  const Eigen::Vector3d arm_base = description.FramePose(arm_base_link).translation();
+  const auto [low, high] = description.BaseOutline();
+  const Eigen::Vector2d body_min = low.array() - parameters.body_margin, body_max = high.array() + parameters.body_margin;
+  // Points per cell, of those that can matter to the arm and are neither ground nor the robot.
+  const double cell = parameters.cell;
+  std::map<std::array<int, 3>, int> counts;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    if (!p.allFinite() || p.z() < 2.0 * parameters.ground_clearance) continue;
+    if ((p - arm_base).norm() > parameters.reach) continue;
+    if ((p.head<2>().array() >= body_min.array()).all() && (p.head<2>().array() <= body_max.array()).all()) continue;
+    if (i < covariances.size() &&
+        covariances[i].diagonal().maxCoeff() > parameters.max_point_sigma * parameters.max_point_sigma) {
+      continue;
+    }
+    ++counts[{static_cast<int>(std::floor(p.x() / cell)), static_cast<int>(std::floor(p.y() / cell)),
+              static_cast<int>(std::floor(p.z() / cell))}];
+  }
+  // Grown by the margin: every cell within it of an occupied one.
+  const int grow = static_cast<int>(std::ceil(parameters.margin / cell - 1e-9));
+  std::map<std::array<int, 3>, bool> occupied;
+  for (const auto& [key, count] : counts) {
+    if (count < parameters.min_points_per_cell) continue;
+    for (int dx = -grow; dx <= grow; ++dx) {
+      for (int dy = -grow; dy <= grow; ++dy) {
+        for (int dz = -grow; dz <= grow; ++dz) occupied[{key[0] + dx, key[1] + dy, key[2] + dz}] = true;
+      }
+    }
+  }
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(occupied.size());
+  for (const auto& [key, unused] : occupied) {
+    centres.emplace_back((key[0] + 0.5) * cell, (key[1] + 0.5) * cell, (key[2] + 0.5) * cell);
+  }
+  environment->Clear();
+  environment->AddGround("ground", parameters.ground_clearance);
+  environment->AddOccupiedPoints("perceived", centres, cell);
+  return static_cast<int>(centres.size());
+}
+
 const char* ToString(ArmExecutive::Mode mode) {
   switch (mode) {
     case ArmExecutive::Mode::kIdle: return "idle";
@@ -30,10 +75,7 @@ ArmExecutive::ArmExecutive(const robot::RobotDescription& description, const Arm
       kinematics_(description),
       collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
       planner_(std::make_unique<ArmPlanner>(kinematics_, *collision_, parameters.planner)),
-      arm_base_(description.FramePose(kinematics_.links().front()).translation()) {
-  const auto [low, high] = description.BaseOutline();
-  body_min_ = low.array() - parameters.body_margin;
-  body_max_ = high.array() + parameters.body_margin;
+      description_(description) {
   collision_->environment().AddGround("ground", parameters_.ground_clearance);
 }
 
@@ -57,41 +99,7 @@ void ArmExecutive::SetJointState(const messages::ArmJointState& joints) {
 
 void ArmExecutive::SetPerceivedPoints(const std::vector<Eigen::Vector3d>& points,
                                       const std::vector<Eigen::Matrix3d>& covariances) {
-  // Points per cell, of those that can matter to the arm and are neither ground nor the robot.
-  const double cell = parameters_.cell;
-  std::map<std::array<int, 3>, int> counts;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d& p = points[i];
-    if (!p.allFinite() || p.z() < 2.0 * parameters_.ground_clearance) continue;
-    if ((p - arm_base_).norm() > parameters_.reach) continue;
-    if ((p.head<2>().array() >= body_min_.array()).all() && (p.head<2>().array() <= body_max_.array()).all()) continue;
-    if (i < covariances.size() && covariances[i].diagonal().maxCoeff() > parameters_.max_point_sigma * parameters_.max_point_sigma) {
-      continue;
-    }
-    ++counts[{static_cast<int>(std::floor(p.x() / cell)), static_cast<int>(std::floor(p.y() / cell)),
-              static_cast<int>(std::floor(p.z() / cell))}];
-  }
-  // Grown by the margin: every cell within it of an occupied one.
-  const int grow = static_cast<int>(std::ceil(parameters_.margin / cell - 1e-9));
-  std::map<std::array<int, 3>, bool> occupied;
-  for (const auto& [key, count] : counts) {
-    if (count < parameters_.min_points_per_cell) continue;
-    for (int dx = -grow; dx <= grow; ++dx) {
-      for (int dy = -grow; dy <= grow; ++dy) {
-        for (int dz = -grow; dz <= grow; ++dz) occupied[{key[0] + dx, key[1] + dy, key[2] + dz}] = true;
-      }
-    }
-  }
-  std::vector<Eigen::Vector3d> centres;
-  centres.reserve(occupied.size());
-  for (const auto& [key, unused] : occupied) {
-    centres.emplace_back((key[0] + 0.5) * cell, (key[1] + 0.5) * cell, (key[2] + 0.5) * cell);
-  }
-  robot::CollisionEnvironment& environment = collision_->environment();
-  environment.Clear();
-  environment.AddGround("ground", parameters_.ground_clearance);
-  environment.AddOccupiedPoints("perceived", centres, cell);
-  perceived_cells_ = static_cast<int>(centres.size());
+  perceived_cells_ = BuildPerceivedEnvironment(description_, parameters_, points, covariances, &collision_->environment());
   environment_ready_ = true;
   planner_->ResetRoadmap();
 }

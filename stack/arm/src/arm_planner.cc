@@ -290,7 +290,8 @@ ArmPlan ArmPlanner::Plan(const Eigen::VectorXd& start, const std::vector<Eigen::
   }
   og::PathGeometric path = *problem->getSolutionPath()->as<og::PathGeometric>();
   og::PathSimplifier simplifier(ompl_->si);
-  simplifier.simplifyMax(path);
+  simplifier.reduceVertices(path);
+  simplifier.shortcutPath(path);
   std::vector<Eigen::VectorXd> states;
   for (size_t k = 1; k < path.getStateCount(); ++k) states.push_back(ompl_->ToVector(path.getState(k)));
   SetWaypoints(start, states, &plan);

@@ -58,13 +58,15 @@ class ArmExecutive {
  public:
   enum class Mode { kIdle, kWaitingForEnvironment, kMoving, kSettling, kDone };
 
+  // `description` must outlive the executive.
   ArmExecutive(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters);
   ~ArmExecutive();
 
   // Cutter poses in base_link, reached in order while the base stands still.
   void SetGoals(const std::vector<Eigen::Isometry3d>& cutter_poses);
   void SetJointState(const messages::ArmJointState& joints);
-  // What stereo saw (base_link), replacing what it saw before; the roadmap starts afresh.
+  // What stereo saw (base_link), replacing what it saw before (BuildPerceivedEnvironment); the
+  // roadmap starts afresh.
   void SetPerceivedPoints(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances);
   bool WantsEnvironment() const { return mode_ == Mode::kWaitingForEnvironment && !environment_ready_; }
   std::optional<messages::ArmCommand> Update(double stamp);
@@ -89,8 +91,7 @@ class ArmExecutive {
   ArmKinematics kinematics_;
   std::unique_ptr<robot::CollisionModel> collision_;
   std::unique_ptr<ArmPlanner> planner_;
-  Eigen::Vector3d arm_base_;                  // base_link
-  Eigen::Vector2d body_min_, body_max_;       // the base's outline, grown by body_margin
+  const robot::RobotDescription& description_;
 
   Mode mode_ = Mode::kIdle;
   std::vector<Eigen::Isometry3d> goals_;
@@ -107,5 +108,13 @@ class ArmExecutive {
 };
 
 const char* ToString(ArmExecutive::Mode mode);
+
+// The environment the planner avoids, from stereo points in base_link: the ground plane at
+// ground_clearance, and octree cells of `cell` holding at least min_points_per_cell certain points
+// within reach of the arm's base, outside the base's outline and above the ground, grown by
+// `margin`. Replaces what `environment` held; returns the number of occupied cells.
+int BuildPerceivedEnvironment(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters,
+                              const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances,
+                              robot::CollisionEnvironment* environment);
 
 }  // namespace trimbot::arm
