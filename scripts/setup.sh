@@ -11,7 +11,7 @@ PACKAGES=(
   libmujoco-dev libqhull-dev libosmesa6-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev libopencv-features2d-dev
   libopencv-flann-dev
-  liborocos-kdl-dev libfcl-dev
+  liborocos-kdl-dev libfcl-dev liboctomap-dev
   libompl-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
 )

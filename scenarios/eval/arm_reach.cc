@@ -39,7 +39,8 @@ robot::CollisionCheckOptions EnvironmentClearance() {
 
 ArmWorld MakeArmWorld(const Scenario& scenario, const sim::Simulator& simulator, const Eigen::Isometry3d& T_map_base) {
   const ArmReach& spec = *scenario.arm_reach;
-  ArmWorld world{robot::CollisionModel(simulator.robot(), simulator.robot().ArmJointNames()), {}, {}};
+  ArmWorld world{robot::CollisionModel(simulator.robot(), simulator.robot().ArmJointNames()), {}, {},
+                 simulator.garden().name};
   const auto& objects = simulator.garden().objects;
   const auto bush = std::find_if(objects.begin(), objects.end(), [&](const garden::GardenObject& o) { return o.id == spec.bush; });
   const std::string what = "arm_reach: bush " + std::to_string(spec.bush) + ": ";
@@ -69,7 +70,9 @@ std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const 
                                                 const robot::RobotDescription& robot,
                                                 const Eigen::Isometry3d& T_map_base, std::uint64_t seed) {
   const ArmReach& spec = *scenario.arm_reach;
-  Rng rng = MakeRng(seed, "arm_reach_poses");
+  // Each garden and bush its own stream: with the same seed, two bushes of a similar size would
+  // otherwise share the poses both accept.
+  Rng rng = MakeRng(seed, "arm_reach_poses/" + world.garden + "/" + std::to_string(spec.bush));
   const auto uniform = [&rng]() { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };  // portable
   const std::vector<std::string> names = robot.ArmJointNames();
   std::vector<ArmReachPose> poses;

@@ -34,6 +34,7 @@ struct ArmWorld {
   robot::CollisionModel model;
   std::vector<int> bush;           // environment indices of the bush's hulls
   Eigen::Vector3d bush_centre = Eigen::Vector3d::Zero();
+  std::string garden;              // its name
 };
 
 // Throws InputError naming the scenario when the bush is not a bush of the garden.

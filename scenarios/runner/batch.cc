@@ -107,10 +107,12 @@ std::optional<TrialResult> ReadTrialResult(const std::string& dir) {
 std::string OneLine(const TrialResult& r) {
   int reached = 0;
   for (const auto& g : r.goals) reached += g.reached ? 1 : 0;
+  for (const auto& g : r.arm_goals) reached += g.reached ? 1 : 0;
   std::ostringstream line;
   line << std::fixed << std::setprecision(1) << "trial " << std::setw(3) << std::setfill('0') << r.index
        << std::setfill(' ') << " seed " << r.seed << ": " << (r.success ? "success" : "FAILED") << " (" << r.status
-       << (r.message.empty() ? "" : ": " + r.message) << "), goals " << reached << "/" << r.goals.size() << ", "
+       << (r.message.empty() ? "" : ": " + r.message) << "), " << (r.arm_goals.empty() ? "goals " : "cutter poses ")
+       << reached << "/" << r.goals.size() + r.arm_goals.size() << ", "
        << r.simulated_seconds << " s simulated, " << r.wall_seconds << " s wall";
   for (const auto& e : r.estimates) {
     if (e.name == "ekf" && !e.position_m.empty()) {
