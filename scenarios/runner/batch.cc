@@ -130,6 +130,7 @@ std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<T
   double total = 0.0;
   std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
   std::vector<RunTiming> runs;
+  std::vector<double> arm_plans;  // s, every arm plan of every trial
   for (const auto& r : results) {
     trials.push_back({{"index", r.index}, {"seed", r.seed}, {"wall_seconds", r.wall_seconds}});
     total += r.wall_seconds;
@@ -142,12 +143,21 @@ std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<T
     } catch (const std::exception& e) {
       // A trial folder from an older version: its stages are left out of the sum, not guessed.
     }
+    if (timing.is_object() && timing.contains("arm_planning_seconds")) {
+      const auto plans = timing["arm_planning_seconds"].get<std::vector<double>>();
+      arm_plans.insert(arm_plans.end(), plans.begin(), plans.end());
+    }
     if (timing.is_object() && timing.contains("visual_localization")) {
       const auto trial_frames = LocalizationTimesFromJson(timing["visual_localization"]);
       frames.insert(frames.end(), trial_frames.begin(), trial_frames.end());
     }
   }
   json report{{"trials", trials}, {"mean_wall_seconds", results.empty() ? 0.0 : total / results.size()}};
+  if (!arm_plans.empty()) {
+    std::sort(arm_plans.begin(), arm_plans.end());
+    const auto at = [&](double q) { return 1e3 * arm_plans[static_cast<size_t>(q * (arm_plans.size() - 1))]; };
+    report["arm_planning_ms"] = {{"plans", arm_plans.size()}, {"median", at(0.5)}, {"p90", at(0.9)}, {"max", at(1.0)}};
+  }
   if (!frames.empty()) {
     report["visual_localization"] = LocalizationTimeStats(frames);
     report["visual_localization"].erase("frames_ms");  // in the trials' files
@@ -219,6 +229,16 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
               << " (actual " << c.actual << ")\n";
   }
   if (timing) log << "summed over the trials' processes, " << FormatRunTiming(*timing);
+  if (scenario.arm_reach) {
+    std::ifstream file(out + "/timing.json");
+    const json report = json::parse(file, nullptr, false);
+    if (report.is_object() && report.contains("arm_planning_ms")) {
+      const json& plans = report["arm_planning_ms"];
+      log << "arm planning (wall clock, IK included): median " << plans["median"].get<double>() << " ms, 90th percentile "
+          << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>() << " ms over "
+          << plans["plans"].get<int>() << " plans\n";
+    }
+  }
   log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
                              : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");

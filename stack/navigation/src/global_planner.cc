@@ -126,6 +126,16 @@ namespace {
 // m: where the planner arrives from when RRT* cannot join the goal itself (GlobalPlanner::Plan).
 constexpr double kGoalApproach = 0.4;
 
+// The motion validator's verdict on the straight segment a -> b.
+bool Motion(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
+  from[0] = a.x();
+  from[1] = a.y();
+  to[0] = b.x();
+  to[1] = b.y();
+  return si->checkMotion(from.get(), to.get());
+}
+
 // RRT* from `start` to `goal` on `si`, simplified; nullopt (with the reason in `*message`) when
 // the iterations found no exact solution.
 std::optional<std::vector<Eigen::Vector2d>> RrtStar(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& start,
@@ -157,17 +167,9 @@ std::optional<std::vector<Eigen::Vector2d>> RrtStar(const ob::SpaceInformationPt
   simplifier.simplifyMax(path);
   std::vector<Eigen::Vector2d> points;
   for (const ob::State* state : path.getStates()) points.push_back(Point(state));
+  // RRT* stops within half a cell of the goal: end on the goal itself when that last step is free.
+  if (points.back() != goal && Motion(si, points.back(), goal)) points.push_back(goal);
   return points;
-}
-
-// The motion validator's verdict on the straight segment a -> b.
-bool Motion(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
-  from[0] = a.x();
-  from[1] = a.y();
-  to[0] = b.x();
-  to[1] = b.y();
-  return si->checkMotion(from.get(), to.get());
 }
 
 }  // namespace
