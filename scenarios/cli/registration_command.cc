@@ -98,7 +98,10 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
   auto* command = app.add_subcommand(
       "register", "register point-cloud pairs (DUGMA data set format) and report errors against ground truth");
   command->add_option("folder", options->folder, "folder of pair_NN.txt files")->required();
-  command->add_option("--method", options->method, "dugma or icp")->check(CLI::IsMember({"dugma", "icp"}));
+  command->add_option("--method", options->method,
+                      "dugma, or a baseline by Open3D: icp (point-to-point), icp_plane (point-to-plane), gicp "
+                      "(generalized ICP)")
+      ->check(CLI::IsMember({"dugma", "icp", "icp_plane", "gicp"}));
   command->add_option("--exclude", options->exclude, "pair names to leave out (e.g. pair_26)");
   auto& r = options->registration;
   command->add_option("--iterations", r.max_iterations, "most EM / ICP iterations")->check(CLI::PositiveNumber);
@@ -116,8 +119,10 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     if (files.empty()) throw InputError(options->folder, "holds no .txt pair files");
 
     perception::RegistrationOptions registration = options->registration;
-    registration.method = options->method == "icp" ? perception::RegistrationMethod::kIcp
-                                                    : perception::RegistrationMethod::kDugma;
+    registration.method = options->method == "icp"         ? perception::RegistrationMethod::kIcpPointToPoint
+                          : options->method == "icp_plane" ? perception::RegistrationMethod::kIcpPointToPlane
+                          : options->method == "gicp"      ? perception::RegistrationMethod::kGeneralizedIcp
+                                                           : perception::RegistrationMethod::kDugma;
     registration.relative_covariances = true;  // the data set's covariances are relative weights
     registration.max_variance = 1e5;           // its 1e6 entries mark unusable points
 

@@ -1,6 +1,8 @@
 #include "trimbot/common/rotation.h"
 #include "trimbot/perception/registration.h"
 
+#include "open3d_icp.h"
+
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <nanoflann.hpp>
@@ -221,9 +223,9 @@ struct EStep {
   const PointCloud& moving;
   Eigen::Matrix3d R;
   Eigen::Vector3d t;
-  bool icp = false, isotropic = true;
+  bool isotropic = true;
   int k = 1;
-  double spread2 = 0.0, icp_reject2 = 0.0, gate2 = 0.0, typical_target_variance = 0.0, outlier_weight = 0.0;
+  double spread2 = 0.0, gate2 = 0.0, typical_target_variance = 0.0, outlier_weight = 0.0;
 
   // The pair terms of source point j (posterior weights of its k nearest target points).
   SourceTerms Terms(std::size_t j) const {
@@ -232,14 +234,6 @@ struct EStep {
     std::uint32_t index[64];
     double d2[64];
     const std::size_t found = level.tree->knnSearch(y.data(), static_cast<std::size_t>(std::min(k, 64)), index, d2);
-    if (icp) {
-      if (found == 0 || d2[0] > icp_reject2) return term;
-      term.weight = 1.0;
-      term.weighted_target = level.cloud.points[index[0]];
-      term.cost = d2[0];
-      term.pairs = 1;
-      return term;
-    }
     const Eigen::Matrix3d source_cov = R * moving.covariances[j] * R.transpose();
     // Outlier term: the density of a pair at the truncation distance with typical covariances.
     const Eigen::Matrix3d typical = source_cov + (typical_target_variance + spread2) * Eigen::Matrix3d::Identity();
@@ -304,7 +298,7 @@ struct EStep {
 };
 
 // M-step: the transform that best explains the pairs (weighted Kabsch when every covariance is
-// isotropic or for ICP, else one Gauss-Newton step on SE(3)).
+// isotropic, else one Gauss-Newton step on SE(3)).
 Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud& moving, const Eigen::Isometry3d& T,
                         bool closed_form, int pairs) {
   if (closed_form) return WeightedKabsch(terms, moving.points);
@@ -334,19 +328,22 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
   Prepared p;
   Prepare(target_in, source_in, options, &result, &p);
   Eigen::Isometry3d T = initial;
+  if (options.method != RegistrationMethod::kDugma) {  // the baselines: Open3D's ICP variants
+    RegistrationResult icp = Open3dIcp(p.target, p.source, T, options, p.point_spacing);
+    icp.target_points = result.target_points;
+    icp.source_points = result.source_points;
+    return icp;
+  }
   double anneal = options.anneal_start < 0.0 ? InitialSpread(p, T) : options.anneal_start;
-  const bool icp = options.method == RegistrationMethod::kIcp;
   std::vector<SourceTerms> terms(p.source.size());
 
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    // The coarsest target whose voxels are no wider than the spread (ICP: always the full cloud).
+    // The coarsest target whose voxels are no wider than the spread.
     std::size_t level_index = 0;
-    while (!icp && level_index + 1 < p.levels.size() && p.levels[level_index + 1].voxel <= anneal) ++level_index;
-    const PointCloud& moving = icp ? p.source : p.source_levels[level_index];
-    // ICP rejects pairs farther than 3 annealing spreads (at least 3 point spacings).
-    const EStep e{p.levels[level_index], moving, T.linear(), T.translation(), icp, p.isotropic,
-                  icp ? 1 : std::max(1, options.neighbours), 2.0 * anneal * anneal,
-                  std::pow(3.0 * std::max(anneal, p.point_spacing), 2),
+    while (level_index + 1 < p.levels.size() && p.levels[level_index + 1].voxel <= anneal) ++level_index;
+    const PointCloud& moving = p.source_levels[level_index];
+    const EStep e{p.levels[level_index], moving, T.linear(), T.translation(), p.isotropic,
+                  std::max(1, options.neighbours), 2.0 * anneal * anneal,
                   options.truncation_sigmas * options.truncation_sigmas, p.typical_target_variance, options.outlier_weight};
     terms.resize(moving.size());
     // E-step, in parallel over source points; each writes only its own terms (deterministic).
@@ -362,7 +359,7 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
       matched += term.weight > 0.0 ? 1 : 0;
       pairs += term.pairs;
     }
-    const Eigen::Isometry3d next = MStep(terms, moving, T, icp || p.isotropic, pairs);
+    const Eigen::Isometry3d next = MStep(terms, moving, T, p.isotropic, pairs);
     result.iterations = iteration + 1;
     if (pairs == 0 || !next.matrix().allFinite()) break;  // nothing matched: keep the last transform
     const double step = std::acos(std::clamp(((next.linear().transpose() * T.linear()).trace() - 1.0) / 2.0, -1.0, 1.0)) +

@@ -12,8 +12,8 @@
 // annealing term (an isotropic spread added to every pair, shrinking each iteration) widens the
 // basin at the start - the "dynamic" part.
 //
-// ICP (point-to-point, nearest neighbour, annealed rejection distance) is the baseline through the
-// same API.
+// The baselines go through the same API: Open3D's ICP (point-to-point, point-to-plane) and
+// generalized ICP, coarse to fine from the target's RMS radius down to 3 point spacings.
 #include <Eigen/Geometry>
 #include <stdexcept>
 #include <string>
@@ -22,7 +22,7 @@
 
 namespace trimbot::perception {
 
-enum class RegistrationMethod { kDugma, kIcp };
+enum class RegistrationMethod { kDugma, kIcpPointToPoint, kIcpPointToPlane, kGeneralizedIcp };
 
 struct RegistrationOptions {
   RegistrationMethod method = RegistrationMethod::kDugma;
@@ -45,7 +45,7 @@ struct RegistrationOptions {
 
 struct RegistrationResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // x = transform * y
-  int iterations = 0;
+  int iterations = 0;               // EM iterations (DUGMA); the stages' budget (ICP: Open3D reports no count)
   bool converged = false;
   double final_cost = 0.0;          // weighted mean squared Mahalanobis distance of the pairs
   int pairs = 0;                    // pairs with weight in the last E-step
