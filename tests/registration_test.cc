@@ -2,10 +2,13 @@
 // transforms and noise; bad input; the DUGMA data set's file format.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <cmath>
 #include <random>
 
 #include "cli/registration_command.h"
+#include "cli/registration_cv.h"
 #include "eval/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
@@ -121,4 +124,29 @@ TEST(RegistrationPairFile, ReadsTheDataSetFormatAndNamesBadLines) {
 }
 
 }  // namespace
+// Cross-validation reports every pair once, from the fold it was left out of, with parameters
+// chosen on the other folds, and the ICP baseline beside it.
+TEST(CrossValidation, EveryPairFromItsOwnFoldWithTheBaselineBeside) {
+  std::vector<scenarios::RegistrationPair> pairs;
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    scenarios::RegistrationPair pair;
+    pair.name = "synthetic_" + std::to_string(k);
+    pair.truth = Transform(10.0 + 3.0 * k, 5.0, {0.2, -0.1, 0.05});
+    pair.x = GardenScene(1000, 20 + k, false);
+    pair.y = ObservedFrom(GardenScene(1000, 30 + k, false), pair.truth, 40 + k);
+    pairs.push_back(std::move(pair));
+  }
+  std::ostringstream table;
+  const auto rows = scenarios::CrossValidateDugma(pairs, 2, RegistrationOptions{}, table);
+  ASSERT_EQ(rows.size(), 4u);
+  for (std::size_t p = 0; p < rows.size(); ++p) {
+    EXPECT_EQ(rows[p].pair, pairs[p].name);
+    EXPECT_EQ(rows[p].fold, static_cast<int>(p % 2));
+    EXPECT_FALSE(rows[p].parameters.empty());
+    EXPECT_LT(rows[p].rotation_deg, 1.0) << rows[p].pair;
+    EXPECT_GE(rows[p].icp_rotation_deg, 0.0);
+  }
+  EXPECT_NE(table.str().find("cross-validated (2 folds"), std::string::npos) << table.str();
+}
+
 }  // namespace trimbot::perception

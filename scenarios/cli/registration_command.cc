@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "eval/pose_errors.h"
+#include "cli/registration_cv.h"
 #include "eval/trial_result.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/registration.h"
@@ -92,6 +93,7 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     std::string folder;
     std::string method = "dugma";
     std::vector<std::string> exclude;
+    int folds = 0;
     perception::RegistrationOptions registration;
   };
   auto options = std::make_shared<Options>();
@@ -103,6 +105,9 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
                       "(generalized ICP)")
       ->check(CLI::IsMember({"dugma", "icp", "icp_plane", "gicp"}));
   command->add_option("--exclude", options->exclude, "pair names to leave out (e.g. pair_26)");
+  command->add_option("--cross-validate", options->folds,
+                      "K: choose DUGMA's parameters on K-1 folds of the pairs, report each pair from its own fold")
+      ->check(CLI::Range(2, 1000));
   auto& r = options->registration;
   command->add_option("--iterations", r.max_iterations, "most EM / ICP iterations")->check(CLI::PositiveNumber);
   command->add_option("--neighbours", r.neighbours, "target points per source point (DUGMA)")->check(CLI::Range(1, 64));
@@ -126,6 +131,21 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     registration.relative_covariances = true;  // the data set's covariances are relative weights
     registration.max_variance = 1e5;           // its 1e6 entries mark unusable points
 
+    if (options->folds > 0) {
+      std::vector<RegistrationPair> pairs;
+      for (const auto& file : files) {
+        RegistrationPair pair = LoadRegistrationPair(file);
+        if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) == options->exclude.end()) {
+          pairs.push_back(std::move(pair));
+        }
+      }
+      if (static_cast<int>(pairs.size()) < options->folds) {
+        throw InputError(options->folder, "fewer pairs than --cross-validate folds");
+      }
+      CrossValidateDugma(pairs, options->folds, registration, std::cout);
+      exit_code = 0;
+      return;
+    }
     std::cout << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
               << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)"
               << std::setw(7) << "iters" << std::setw(10) << "time (s)" << "\n";
