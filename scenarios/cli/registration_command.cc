@@ -22,6 +22,19 @@ namespace fs = std::filesystem;
 
 double Median(const std::vector<double>& v) { return ErrorStats::From(v).median; }
 
+perception::PointCloud EveryKth(const perception::PointCloud& cloud, int k) {
+  if (k <= 1) return cloud;
+  perception::PointCloud thinned;
+  for (std::size_t i = 0; i < cloud.size(); i += static_cast<std::size_t>(k)) thinned.Add(cloud.points[i], cloud.covariances[i]);
+  return thinned;
+}
+
+RegistrationPair Thinned(RegistrationPair pair, int target_every, int source_every) {
+  pair.x = EveryKth(pair.x, target_every);
+  pair.y = EveryKth(pair.y, source_every);
+  return pair;
+}
+
 }  // namespace
 
 RegistrationPair LoadRegistrationPair(const std::string& path) {
@@ -94,6 +107,7 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     std::string method = "dugma";
     std::vector<std::string> exclude;
     int folds = 0;
+    int thin_target = 1, thin_source = 1;
     perception::RegistrationOptions registration;
   };
   auto options = std::make_shared<Options>();
@@ -105,6 +119,10 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
                       "(generalized ICP)")
       ->check(CLI::IsMember({"dugma", "icp", "icp_plane", "gicp"}));
   command->add_option("--exclude", options->exclude, "pair names to leave out (e.g. pair_26)");
+  command->add_option("--thin-target", options->thin_target,
+                      "keep every K-th point of X (how registration holds up on sparse clouds)")
+      ->check(CLI::Range(1, 1000));
+  command->add_option("--thin-source", options->thin_source, "keep every K-th point of Y")->check(CLI::Range(1, 1000));
   command->add_option("--cross-validate", options->folds,
                       "K: choose DUGMA's parameters on K-1 folds of the pairs, report each pair from its own fold")
       ->check(CLI::Range(2, 1000));
@@ -134,7 +152,7 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     if (options->folds > 0) {
       std::vector<RegistrationPair> pairs;
       for (const auto& file : files) {
-        RegistrationPair pair = LoadRegistrationPair(file);
+        RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
         if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) == options->exclude.end()) {
           pairs.push_back(std::move(pair));
         }
@@ -152,7 +170,7 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
     std::vector<double> rotation, translation, seconds;
     int under_5_degrees = 0;
     for (const auto& file : files) {
-      const RegistrationPair pair = LoadRegistrationPair(file);
+      const RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
       if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) != options->exclude.end()) continue;
       const auto start = std::chrono::steady_clock::now();
       const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), registration);

@@ -123,6 +123,26 @@ Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const st
 
 namespace {
 
+// Median distance from a point to its nearest other point (of up to 2000 points spread over the cloud).
+double MedianSpacing(const PointCloud& cloud, const KdTree& tree) {
+  std::vector<double> spacing;
+  for (std::size_t i = 0; i < cloud.size(); i += std::max<std::size_t>(1, cloud.size() / 2000)) {
+    std::uint32_t index[2];
+    double d2[2];
+    if (tree.knnSearch(cloud.points[i].data(), 2, index, d2) == 2) spacing.push_back(std::sqrt(d2[1]));
+  }
+  return std::max(Median(spacing), 1e-6);
+}
+
+// Covariances given as relative weights, scaled so that the median point variance is the squared
+// point spacing.
+void ScaleRelativeCovariances(double spacing, PointCloud* cloud) {
+  std::vector<double> variances;
+  for (const auto& c : cloud->covariances) variances.push_back(c.trace() / 3.0);
+  const double scale = spacing * spacing / std::max(Median(variances), 1e-300);
+  for (auto& c : cloud->covariances) c *= scale;
+}
+
 // The clouds as registration uses them: cleaned, covariances scaled, and a pyramid of voxel
 // levels of the target (with a k-d tree each) and of the source.
 struct Prepared {
@@ -151,20 +171,17 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
   const KdTree& tree = *p->levels[0].tree;
 
   // Median spacing of the target (nearest other point), the scale of "close".
-  std::vector<double> spacing;
-  for (std::size_t i = 0; i < target.size(); i += std::max<std::size_t>(1, target.size() / 2000)) {
-    std::uint32_t index[2];
-    double d2[2];
-    if (tree.knnSearch(target.points[i].data(), 2, index, d2) == 2) spacing.push_back(std::sqrt(d2[1]));
-  }
-  p->point_spacing = std::max(Median(spacing), 1e-6);
+  p->point_spacing = MedianSpacing(target, tree);
 
   if (options.relative_covariances) {
-    std::vector<double> variances;
-    for (const auto& c : target.covariances) variances.push_back(c.trace() / 3.0);
-    const double scale = p->point_spacing * p->point_spacing / std::max(Median(variances), 1e-300);
-    for (auto& c : target.covariances) c *= scale;
-    for (auto& c : source.covariances) c *= scale;
+    // Relative weights become variances with each cloud's own density: a sparse cloud's points
+    // stand for more surface than a dense one's (with the target's scale for both, a target thinned
+    // to ~500 points left the median error at 2.0 deg on the shared pairs).
+    TargetLevel source_level;
+    source_level.cloud = source;
+    source_level.Build();
+    ScaleRelativeCovariances(p->point_spacing, &target);
+    ScaleRelativeCovariances(MedianSpacing(source, *source_level.tree), &source);
   }
   for (const auto& c : target.covariances) p->isotropic = p->isotropic && IsIsotropic(c);
   for (const auto& c : source.covariances) p->isotropic = p->isotropic && IsIsotropic(c);
