@@ -35,6 +35,39 @@ RegistrationPair Thinned(RegistrationPair pair, int target_every, int source_eve
   return pair;
 }
 
+// One row per pair (sizes, errors, time, the EM's state, the both-ways check) and the medians.
+void RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::RegistrationOptions& registration,
+                  const std::string& method, std::ostream& out) {
+  out << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
+      << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)" << std::setw(7)
+      << "iters" << std::setw(10) << "time (s)" << std::setw(9) << "matched" << std::setw(6) << "conv" << std::setw(9)
+      << "cost" << std::setw(11) << "both ways" << "\n";
+  std::vector<double> rotation, translation, seconds;
+  int under_5_degrees = 0;
+  for (const RegistrationPair& pair : pairs) {
+    const auto start = std::chrono::steady_clock::now();
+    const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), registration);
+    const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double r = RotationErrorDegrees(result.transform, pair.truth);
+    const double t = TranslationError(result.transform, pair.truth);
+    rotation.push_back(r);
+    translation.push_back(t);
+    seconds.push_back(time);
+    under_5_degrees += r < 5.0 ? 1 : 0;
+    const int dropped =
+        static_cast<int>(pair.x.size() + pair.y.size()) - result.target_points.kept - result.source_points.kept;
+    out << std::left << std::setw(10) << pair.name << std::right << std::setw(8) << pair.x.size() << std::setw(8)
+        << pair.y.size() << std::setw(9) << dropped << std::fixed << std::setprecision(2) << std::setw(11) << r
+        << std::setprecision(3) << std::setw(11) << t << std::setw(7) << result.iterations << std::setw(10) << time
+        << std::setprecision(2) << std::setw(9) << result.matched_fraction << std::setw(6) << result.converged
+        << std::setw(9) << result.final_cost << std::setw(11) << result.consistency_deg
+        << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
+  }
+  out << std::fixed << std::setprecision(3) << "median (" << method << ", " << rotation.size() << " pairs): rotation "
+      << Median(rotation) << " deg, translation " << Median(translation) << " m, time " << Median(seconds)
+      << " s (both ways); " << under_5_degrees << " of " << rotation.size() << " under 5 deg\n";
+}
+
 }  // namespace
 
 RegistrationPair LoadRegistrationPair(const std::string& path) {
@@ -147,51 +180,24 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
                           : options->method == "gicp"      ? perception::RegistrationMethod::kGeneralizedIcp
                                                            : perception::RegistrationMethod::kDugma;
     registration.relative_covariances = true;  // the data set's covariances are relative weights
+    registration.check_consistency = true;     // say which results are not to be trusted
     registration.max_variance = 1e5;           // its 1e6 entries mark unusable points
 
-    if (options->folds > 0) {
-      std::vector<RegistrationPair> pairs;
-      for (const auto& file : files) {
-        RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
-        if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) == options->exclude.end()) {
-          pairs.push_back(std::move(pair));
-        }
-      }
-      if (static_cast<int>(pairs.size()) < options->folds) {
-        throw InputError(options->folder, "fewer pairs than --cross-validate folds");
-      }
-      CrossValidateDugma(pairs, options->folds, registration, std::cout);
-      exit_code = 0;
-      return;
-    }
-    std::cout << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
-              << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)"
-              << std::setw(7) << "iters" << std::setw(10) << "time (s)" << "\n";
-    std::vector<double> rotation, translation, seconds;
-    int under_5_degrees = 0;
+    std::vector<RegistrationPair> pairs;
     for (const auto& file : files) {
-      const RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
-      if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) != options->exclude.end()) continue;
-      const auto start = std::chrono::steady_clock::now();
-      const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), registration);
-      const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const double r = RotationErrorDegrees(result.transform, pair.truth);
-      const double t = TranslationError(result.transform, pair.truth);
-      rotation.push_back(r);
-      translation.push_back(t);
-      seconds.push_back(time);
-      under_5_degrees += r < 5.0 ? 1 : 0;
-      const int dropped = static_cast<int>(pair.x.size() + pair.y.size()) - result.target_points.kept -
-                          result.source_points.kept;
-      std::cout << std::left << std::setw(10) << pair.name << std::right << std::setw(8) << pair.x.size()
-                << std::setw(8) << pair.y.size() << std::setw(9) << dropped << std::fixed << std::setprecision(2)
-                << std::setw(11) << r << std::setprecision(3) << std::setw(11) << t << std::setw(7)
-                << result.iterations << std::setprecision(3) << std::setw(10) << time << "\n";
+      RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
+      if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) == options->exclude.end()) {
+        pairs.push_back(std::move(pair));
+      }
     }
-    std::cout << std::fixed << std::setprecision(3) << "median (" << options->method << ", " << rotation.size()
-              << " pairs): rotation " << Median(rotation) << " deg, translation " << Median(translation)
-              << " m, time " << Median(seconds) << " s; " << under_5_degrees << " of " << rotation.size()
-              << " under 5 deg\n";
+    if (options->folds > static_cast<int>(pairs.size())) {
+      throw InputError(options->folder, "fewer pairs than --cross-validate folds");
+    }
+    if (options->folds > 0) {
+      CrossValidateDugma(pairs, options->folds, registration, std::cout);
+    } else {
+      RegisterEach(pairs, registration, options->method, std::cout);
+    }
     exit_code = 0;
   });
 }

@@ -8,6 +8,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <deque>
 #include <memory>
@@ -338,8 +339,36 @@ Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud&
 
 }  // namespace
 
+namespace {
+RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
+                                const RegistrationOptions& options);
+}  // namespace
+
 RegistrationResult Register(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
                             const RegistrationOptions& options) {
+  RegistrationResult result = RegisterOnce(target_in, source_in, initial, options);
+  if (!options.check_consistency) return result;
+  // The same pair the other way round, from the same guess: a wrong minimum rarely agrees with
+  // itself both ways, a right one does to within the noise.
+  RegistrationOptions reverse_options = options;
+  reverse_options.check_consistency = false;
+  const RegistrationResult reverse = RegisterOnce(source_in, target_in, initial.inverse(), reverse_options);
+  const Eigen::Isometry3d loop = result.transform * reverse.transform;
+  result.consistency_deg = Eigen::AngleAxisd(loop.linear()).angle() * 180.0 / M_PI;
+  result.consistency_m = loop.translation().norm();
+  if (result.consistency_deg > options.max_inconsistency_deg) {
+    result.trusted = false;
+    std::ostringstream why;
+    why << "registered both ways, the results differ by " << result.consistency_deg << " deg";
+    result.doubt = why.str();
+  }
+  return result;
+}
+
+namespace {
+
+RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
+                                const RegistrationOptions& options) {
   if (!initial.matrix().allFinite()) throw RegistrationError("registration: the initial guess is not finite");
   RegistrationResult result;
   Prepared p;
@@ -384,6 +413,7 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
     T = next;
     result.final_cost = matched > 0 ? cost / matched : 0.0;
     result.pairs = pairs;
+    result.matched_fraction = static_cast<double>(matched) / static_cast<double>(std::max<std::size_t>(1, moving.size()));
     if (step < options.tolerance && anneal == 0.0) {
       result.converged = true;
       break;
@@ -397,5 +427,7 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
   result.transform = T;
   return result;
 }
+
+}  // namespace
 
 }  // namespace trimbot::perception

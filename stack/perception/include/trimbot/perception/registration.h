@@ -41,6 +41,11 @@ struct RegistrationOptions {
   // the median point variance equals the squared median point spacing of the target.
   bool relative_covariances = false;
   double max_variance = 1e4;        // m^2 (or relative units); larger marks an unusable point
+  // Register the pair both ways and call the result untrusted when the two disagree by more than
+  // max_inconsistency_deg (twice the time). If both were within 5 deg of the truth they would
+  // differ by at most 10: more means at least one is off by more than 5 deg (the success bound).
+  bool check_consistency = false;
+  double max_inconsistency_deg = 10.0;
 };
 
 struct RegistrationResult {
@@ -49,6 +54,12 @@ struct RegistrationResult {
   bool converged = false;
   double final_cost = 0.0;          // weighted mean squared Mahalanobis distance of the pairs
   int pairs = 0;                    // pairs with weight in the last E-step
+  double matched_fraction = 0.0;    // of the source points, those with a pair in the last E-step (DUGMA)
+  // With check_consistency: the forward result composed with the reverse one (identity when they
+  // agree), and whether to trust the result, with the reason when not.
+  double consistency_deg = 0.0, consistency_m = 0.0;
+  bool trusted = true;
+  std::string doubt;
   CleanReport target_points, source_points;  // what was usable / dropped
 };
 
