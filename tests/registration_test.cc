@@ -4,11 +4,13 @@
 
 #include <sstream>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 #include "cli/registration_command.h"
 #include "cli/registration_cv.h"
+#include "eval/registration_set.h"
 #include "eval/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
@@ -164,6 +166,34 @@ TEST(Dugma, BothWaysCheckTrustsAGoodResult) {
   EXPECT_TRUE(good.trusted) << good.doubt;
   EXPECT_LT(good.consistency_deg, 2.0);
   EXPECT_GT(good.consistency_deg, 0.0);  // it ran
+}
+
+// The rendered data set's truth and back-projection agree: the second view moved by the truth lies
+// on the first (median distance to the nearest point of X, over the points that have one within
+// 0.2 m, about the Kinect-like noise and the point spacing), and far from it without the truth.
+TEST(RegistrationSet, RenderedPairsLieOnEachOtherUnderTheirTruth) {
+  scenarios::RegistrationSetOptions options;
+  options.pairs = 2;
+  const auto pairs = scenarios::RenderRegistrationPairs(options, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR},
+                                                        testing::TempDir("registration_set"));
+  ASSERT_EQ(pairs.size(), 2u);
+  for (const auto& pair : pairs) {
+    EXPECT_GT(pair.x.size(), 1000u);
+    EXPECT_GT(pair.y.size(), 1000u);
+    const auto median_gap = [&](const Eigen::Isometry3d& T) {
+      std::vector<double> gaps;
+      for (std::size_t j = 0; j < pair.y.size(); j += 10) {
+        const Eigen::Vector3d p = T * pair.y.points[j];
+        double best = 1e9;
+        for (const auto& q : pair.x.points) best = std::min(best, (q - p).norm());
+        if (best < 0.2) gaps.push_back(best);
+      }
+      std::sort(gaps.begin(), gaps.end());
+      return gaps.empty() ? 1e9 : gaps[gaps.size() / 2];
+    };
+    EXPECT_LT(median_gap(pair.truth), 0.03) << pair.name;
+    EXPECT_GT(RotationErrorDegrees(Eigen::Isometry3d::Identity(), pair.truth), 9.9) << "the views differ";
+  }
 }
 
 }  // namespace trimbot::perception

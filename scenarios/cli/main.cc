@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   AddBatchCommands(app, data_root, exit_code);
   AddRegistrationCommand(app, exit_code);
+  AddRegistrationSetCommand(app, exit_code);
   AddCompareCommand(app, exit_code);
   AddTuningCommands(app, data_root, exit_code);
   AddMapCommands(app, data_root, exit_code);

@@ -11,6 +11,7 @@
 
 #include "eval/pose_errors.h"
 #include "cli/registration_cv.h"
+#include "eval/registration_set.h"
 #include "eval/trial_result.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/registration.h"
@@ -199,6 +200,29 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
       RegisterEach(pairs, registration, options->method, std::cout);
     }
     exit_code = 0;
+  });
+}
+
+void AddRegistrationSetCommand(CLI::App& app, int& exit_code) {
+  struct Options {
+    RegistrationSetOptions set;
+    std::string out;
+  };
+  auto options = std::make_shared<Options>();
+  auto* command = app.add_subcommand(
+      "register-set", "render registration pairs with known truth from the twin (Kinect-like depth views of the "
+                      "garden's bushes and objects from two viewpoints), in the DUGMA data set format");
+  command->add_option("--garden", options->set.garden, "garden name or file")->capture_default_str();
+  command->add_option("--pairs", options->set.pairs, "pairs to render")->check(CLI::Range(1, 10000))->capture_default_str();
+  command->add_option("--seed", options->set.seed, "viewpoints and noise")->capture_default_str();
+  command->add_option("--out", options->out, "folder for render_NNN.txt")->required();
+  command->callback([options, &exit_code]() {
+    fs::create_directories(options->out);
+    const auto pairs = RenderRegistrationPairs(options->set, ProjectPaths::Default(), options->out);
+    for (const RegistrationPair& pair : pairs) WriteRegistrationPair(options->out + "/" + pair.name + ".txt", pair);
+    std::cout << pairs.size() << " pairs in " << options->out << " (register them: trimbot register " << options->out
+              << ")\n";
+    exit_code = pairs.size() == static_cast<std::size_t>(options->set.pairs) ? 0 : 1;
   });
 }
 

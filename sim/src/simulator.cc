@@ -448,4 +448,20 @@ std::vector<CollisionHull> Simulator::GardenCollisionHulls() const {
   return hulls;
 }
 
+void Simulator::PlaceRobot(const Pose2D& pose) {
+  World& world = *impl_->world;
+  const mjModel* m = world.model();
+  mjData* d = world.data();
+  const int qpos = m->jnt_qposadr[m->body_jntadr[world.base_body()]];
+  const int dof = m->jnt_dofadr[m->body_jntadr[world.base_body()]];
+  d->qpos[qpos] = pose.x;
+  d->qpos[qpos + 1] = pose.y;
+  d->qpos[qpos + 3] = std::cos(0.5 * pose.yaw);
+  d->qpos[qpos + 4] = 0.0;
+  d->qpos[qpos + 5] = 0.0;
+  d->qpos[qpos + 6] = std::sin(0.5 * pose.yaw);
+  for (int i = 0; i < 6; ++i) d->qvel[dof + i] = 0.0;
+  mj_forward(m, d);
+}
+
 }  // namespace trimbot::sim

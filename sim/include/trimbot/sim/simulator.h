@@ -166,6 +166,9 @@ class Simulator {
   // images; RingTruth's views of the others are empty).
   RingCapture CaptureRing(bool with_ground_truth);
   RingCapture CaptureRing(const messages::RingRequest& request, bool with_ground_truth);
+  // Puts the robot at `pose` on the ground (same height as now), at rest: for data sets of views,
+  // not for runs (the sensors' state is not reset).
+  void PlaceRobot(const Pose2D& pose);
   // A view of the world now from outside the robot (RingRenderer::RenderExternalView).
   cv::Mat RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
                              int width, int height);
