@@ -9,9 +9,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <random>
 
 #include "trimbot/arm/arm_executive.h"
+#include "trimbot/common/random.h"
 #include "trimbot/robot/robot_parameters.h"
 
 namespace {
@@ -32,8 +32,8 @@ struct Setup {
   Setup() {
     const auto p = robot::RobotParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/robot_parameters.yaml");
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
-    std::mt19937_64 rng(3);
-    const auto uniform = [&rng]() { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+    Rng rng(3);
+    const auto uniform = [&rng]() { return UniformUnit(rng); };
     // What stereo sees of the bush: the half facing the robot, 1 cm apart, with 1 cm of noise.
     std::vector<Eigen::Vector3d> points;
     for (double el = -1.2; el <= 1.4; el += 0.025) {

@@ -73,7 +73,7 @@ std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const 
   // Each garden and bush its own stream: with the same seed, two bushes of a similar size would
   // otherwise share the poses both accept.
   Rng rng = MakeRng(seed, "arm_reach_poses/" + world.garden + "/" + std::to_string(spec.bush));
-  const auto uniform = [&rng]() { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };  // portable
+  const auto uniform = [&rng]() { return UniformUnit(rng); };
   const std::vector<std::string> names = robot.ArmJointNames();
   std::vector<ArmReachPose> poses;
   long samples = 0;

@@ -18,15 +18,12 @@ constexpr double kResolutionScale = 0.5;   // 376 x 240: near the Kinect's 320 x
 constexpr double kLateralPixels = 0.8;      // px, Kinect lateral noise
 constexpr int kCamera = 0;                  // cam0 looks along base_link's x
 
-// Portable draws (std distributions differ between standard libraries).
+// Portable draws (common/random.h) from the set's own stream.
 class Draws {
  public:
   Draws(std::uint64_t seed, const std::string& stream) : rng_(MakeRng(seed, stream)) {}
-  double Uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(rng_() >> 11) * 0x1.0p-53; }
-  double Normal() {
-    const double u1 = std::max(Uniform(0.0, 1.0), 1e-300), u2 = Uniform(0.0, 1.0);
-    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-  }
+  double Uniform(double lo, double hi) { return lo + (hi - lo) * UniformUnit(rng_); }
+  double Normal() { return StandardNormal(rng_); }
 
  private:
   Rng rng_;

@@ -125,7 +125,13 @@ std::string OneLine(const TrialResult& r) {
 
 // Wall-clock figures, kept out of summary.json so that the same scenario and seed give the same
 // summary, byte for byte. Returns the trials' stage times summed (none without trial timings).
-std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
+// What the batch's timing.json holds that the log reports too.
+struct BatchTiming {
+  std::optional<RunTiming> summed;  // stages summed over the trials that wrote them
+  json arm_planning;                // {plans, median, p90, max} in ms; null without arm plans
+};
+
+BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
   json trials = json::array();
   double total = 0.0;
   std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
@@ -165,15 +171,16 @@ std::optional<RunTiming> WriteTiming(const std::string& out, const std::vector<T
                                    "visual localization time per frame, " + std::to_string(results.size()) + " trials",
                                    frames);
   }
-  std::optional<RunTiming> summed;
+  BatchTiming timing;
+  if (report.contains("arm_planning_ms")) timing.arm_planning = report["arm_planning_ms"];
   if (!runs.empty()) {
-    summed = Sum(runs);
-    report["stages_summed_over_trials"] = ToJson(*summed);
+    timing.summed = Sum(runs);
+    report["stages_summed_over_trials"] = ToJson(*timing.summed);
     WriteRunTimingChart(out + "/timing.png",
-                        "where the time went, summed over " + std::to_string(runs.size()) + " trials", *summed);
+                        "where the time went, summed over " + std::to_string(runs.size()) + " trials", *timing.summed);
   }
   WriteFileAtomically(out + "/timing.json", report.dump(2));
-  return summed;
+  return timing;
 }
 
 // Summary, JUnit and plots of a set of trial results; returns the exit code.
@@ -204,7 +211,7 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
   WriteFileAtomically(out + "/summary.json", json(summary).dump(2));
   WriteJunitXml(out + "/junit.xml", summary);
 
-  const std::optional<RunTiming> timing = WriteTiming(out, results);
+  const BatchTiming timing = WriteTiming(out, results);
   if (scenario.arm_reach) {
     WriteArmReachPlot(out + "/arm_reach.png", scenario.name + ": cutter poses reached (ground truth)", results);
   } else {
@@ -228,16 +235,12 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
     log << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
               << " (actual " << c.actual << ")\n";
   }
-  if (timing) log << "summed over the trials' processes, " << FormatRunTiming(*timing);
-  if (scenario.arm_reach) {
-    std::ifstream file(out + "/timing.json");
-    const json report = json::parse(file, nullptr, false);
-    if (report.is_object() && report.contains("arm_planning_ms")) {
-      const json& plans = report["arm_planning_ms"];
-      log << "arm planning (wall clock, IK included): median " << plans["median"].get<double>() << " ms, 90th percentile "
-          << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>() << " ms over "
-          << plans["plans"].get<int>() << " plans\n";
-    }
+  if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
+  if (!timing.arm_planning.is_null()) {
+    const json& plans = timing.arm_planning;
+    log << "arm planning (wall clock, IK included): median " << plans["median"].get<double>() << " ms, 90th percentile "
+        << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>() << " ms over "
+        << plans["plans"].get<int>() << " plans\n";
   }
   log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"

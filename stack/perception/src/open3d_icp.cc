@@ -25,7 +25,7 @@ open3d::geometry::PointCloud ToOpen3d(const PointCloud& cloud) {
 }  // namespace
 
 RegistrationResult Open3dIcp(const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
-                             const RegistrationOptions& options, double point_spacing) {
+                             const RegistrationOptions& options, double start_distance, double point_spacing) {
   open3d::geometry::PointCloud x = ToOpen3d(target), y = ToOpen3d(source);
   if (options.method == RegistrationMethod::kIcpPointToPlane) {
     // Normals from ~30 neighbours within 5 point spacings. (Generalized ICP estimates its own
@@ -45,19 +45,11 @@ RegistrationResult Open3dIcp(const PointCloud& target, const PointCloud& source,
     default:
       estimation = std::make_unique<reg::TransformationEstimationPointToPoint>();
   }
-  // Coarse to fine: the distance within which points correspond starts at the target's RMS radius
-  // (a misalignment smaller than the cloud itself is within reach) and halves per stage down to 3
-  // point spacings. Started at DUGMA's annealing spread instead (0.44 m on the benchmark's garden
-  // scene, 20 deg and 0.5 m off), generalized ICP ended 26 deg off.
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : target.points) centroid += p;
-  centroid /= static_cast<double>(target.size());
-  double spread2 = 0.0;
-  for (const auto& p : target.points) spread2 += (p - centroid).squaredNorm();
-  const double rms_radius = std::sqrt(spread2 / static_cast<double>(target.size()));
+  // Coarse to fine: the distance within which points correspond halves per stage down to 3 point
+  // spacings.
   std::vector<double> distances;
   const double finest = 3.0 * point_spacing;
-  for (double d = rms_radius; d > finest; d *= 0.5) distances.push_back(d);
+  for (double d = start_distance; d > finest; d *= 0.5) distances.push_back(d);
   distances.push_back(finest);
   const int per_stage = std::max(10, options.max_iterations / static_cast<int>(distances.size()));
 

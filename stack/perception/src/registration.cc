@@ -213,6 +213,16 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
   for (std::size_t l = 1; l < p->levels.size(); ++l) p->source_levels[l] = VoxelDownsample(source, p->levels[l].voxel);
 }
 
+// The RMS distance of the points from their centroid: the cloud's size.
+double RmsRadius(const PointCloud& cloud) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& point : cloud.points) centroid += point;
+  centroid /= static_cast<double>(cloud.size());
+  double spread2 = 0.0;
+  for (const auto& point : cloud.points) spread2 += (point - centroid).squaredNorm();
+  return std::sqrt(spread2 / static_cast<double>(cloud.size()));
+}
+
 // The annealing spread to start from: the typical distance of the source (at the initial guess)
 // to the target, and at least a fraction of the target's size.
 double InitialSpread(const Prepared& p, const Eigen::Isometry3d& T) {
@@ -226,12 +236,7 @@ double InitialSpread(const Prepared& p, const Eigen::Isometry3d& T) {
   }
   // Points on a plane find near neighbours whatever the misalignment along it, so the spread
   // also starts at a fraction of the target's size.
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& point : p.target.points) centroid += point;
-  centroid /= static_cast<double>(p.target.size());
-  double spread2 = 0.0;
-  for (const auto& point : p.target.points) spread2 += (point - centroid).squaredNorm();
-  const double rms_radius = std::sqrt(spread2 / static_cast<double>(p.target.size()));
+  const double rms_radius = RmsRadius(p.target);
   return std::clamp(std::max(Median(distances), 0.3 * rms_radius), p.point_spacing, 1.0);
 }
 
@@ -375,7 +380,7 @@ RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& s
   Prepare(target_in, source_in, options, &result, &p);
   Eigen::Isometry3d T = initial;
   if (options.method != RegistrationMethod::kDugma) {  // the baselines: Open3D's ICP variants
-    RegistrationResult icp = Open3dIcp(p.target, p.source, T, options, p.point_spacing);
+    RegistrationResult icp = Open3dIcp(p.target, p.source, T, options, RmsRadius(p.target), p.point_spacing);
     icp.target_points = result.target_points;
     icp.source_points = result.source_points;
     return icp;

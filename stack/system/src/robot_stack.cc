@@ -678,11 +678,13 @@ void RobotStack::UpdateMissionTelemetry() {
   telemetry_.bush = bush_status_;
 }
 
+bool RobotStack::NavigationGoalsDone() const {
+  return mission_.empty() || telemetry_.mission == MissionState::kDone || telemetry_.mission == MissionState::kReaching;
+}
+
 bool RobotStack::ArmEnvironmentDue() const {
   if (!arm_mission_ || !components_->arm.WantsEnvironment()) return false;
-  const bool navigation_done = mission_.empty() || telemetry_.mission == MissionState::kDone ||
-                               telemetry_.mission == MissionState::kReaching;
-  return navigation_done && std::abs(last_linear_command_) < 1e-9;
+  return NavigationGoalsDone() && std::abs(last_linear_command_) < 1e-9;
 }
 
 void RobotStack::PerceiveArmEnvironment(const messages::RingFrame& frame) {
@@ -703,9 +705,7 @@ void RobotStack::PerceiveArmEnvironment(const messages::RingFrame& frame) {
 void RobotStack::RunArm(double stamp, messages::RobotCommands* commands) {
   ScopedTimer timer(&telemetry_.timings.arm);
   arm::ArmExecutive& arm = components_->arm;
-  const bool navigation_done = mission_.empty() || telemetry_.mission == MissionState::kDone ||
-                               telemetry_.mission == MissionState::kReaching;
-  if (telemetry_.mission == MissionState::kFailed || !navigation_done) return;
+  if (telemetry_.mission == MissionState::kFailed || !NavigationGoalsDone()) return;
   if (auto command = arm.Update(stamp)) commands->arm = *command;
   telemetry_.arm_results = arm.TakeResults();
   ArmStatus status;

@@ -2,6 +2,8 @@
 // Seeded random streams. Every noise source draws from its own stream, derived from the run's seed
 // and the stream's name, so adding a sensor does not change the noise of the others and the same
 // seed always gives the same run.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string_view>
@@ -24,5 +26,14 @@ inline std::uint64_t StreamSeed(std::uint64_t seed, std::string_view stream) {
 using Rng = std::mt19937_64;
 
 inline Rng MakeRng(std::uint64_t seed, std::string_view stream) { return Rng(StreamSeed(seed, stream)); }
+
+// Portable draws: the std distributions differ between standard libraries, these do not.
+// Uniform in [0, 1) from the generator's top 53 bits.
+inline double UniformUnit(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+// Standard normal by Box-Muller from two uniform draws.
+inline double StandardNormal(Rng& rng) {
+  const double u1 = std::max(UniformUnit(rng), 1e-300), u2 = UniformUnit(rng);
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
 
 }  // namespace trimbot

@@ -219,6 +219,8 @@ class RobotStack {
   // The map pose of the servo's frame (GyroOdometry), by the EKF's estimate now.
   Eigen::Isometry3d MapFromServoFrame() const;
   void UpdateMissionTelemetry();
+  // No navigation goals, or they are done (the arm's goals come after them).
+  bool NavigationGoalsDone() const;
   // The arm waits for its surroundings, the navigation goals are done, and the base stands.
   bool ArmEnvironmentDue() const;
   void PerceiveArmEnvironment(const messages::RingFrame& frame);
