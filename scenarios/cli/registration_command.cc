@@ -7,13 +7,16 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include "eval/pose_errors.h"
+#include "cli/cli_checks.h"
 #include "cli/registration_cv.h"
 #include "eval/registration_set.h"
 #include "eval/trial_result.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/parse_number.h"
 #include "trimbot/perception/registration.h"
 
 namespace trimbot::scenarios {
@@ -37,17 +40,26 @@ RegistrationPair Thinned(RegistrationPair pair, int target_every, int source_eve
 }
 
 // One row per pair (sizes, errors, time, the EM's state, the both-ways check) and the medians.
-void RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::RegistrationOptions& registration,
-                  const std::string& method, std::ostream& out) {
+// Returns the number of pairs that could not be registered (too few usable points).
+int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::RegistrationOptions& registration,
+                 const std::string& method, std::ostream& out) {
   out << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
       << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)" << std::setw(7)
       << "iters" << std::setw(10) << "time (s)" << std::setw(9) << "matched" << std::setw(6) << "conv" << std::setw(9)
       << "cost" << std::setw(11) << "both ways" << "\n";
   std::vector<double> rotation, translation, seconds;
   int under_5_degrees = 0;
+  int unregistered = 0;
   for (const RegistrationPair& pair : pairs) {
     const auto start = std::chrono::steady_clock::now();
-    const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), registration);
+    perception::RegistrationResult result;
+    try {
+      result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), ForPair(registration, pair));
+    } catch (const perception::RegistrationError& e) {
+      out << std::left << std::setw(10) << pair.name << "  not registered: " << e.what() << "\n";
+      ++unregistered;
+      continue;
+    }
     const double time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double r = RotationErrorDegrees(result.transform, pair.truth);
     const double t = TranslationError(result.transform, pair.truth);
@@ -64,87 +76,181 @@ void RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::
         << std::setw(9) << result.final_cost << std::setw(11) << result.consistency_deg
         << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
   }
+  if (rotation.empty()) {
+    out << "no pair registered (" << method << ")\n";
+    return unregistered;
+  }
   out << std::fixed << std::setprecision(3) << "median (" << method << ", " << rotation.size() << " pairs): rotation "
       << Median(rotation) << " deg, translation " << Median(translation) << " m, time " << Median(seconds)
       << " s (both ways); " << under_5_degrees << " of " << rotation.size() << " under 5 deg\n";
+  return unregistered;
 }
 
 }  // namespace
 
-RegistrationPair LoadRegistrationPair(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open the pair file");
-  RegistrationPair pair;
-  pair.name = fs::path(path).stem().string();
-  bool have_r = false, have_t = false;
-  std::string line;
-  int number = 0;
-  perception::PointCloud* block = nullptr;
-  long remaining = 0;
-  auto fail = [&](const std::string& problem) -> void {
-    throw InputError(path, "line " + std::to_string(number) + ": " + problem);
-  };
-  while (std::getline(in, line)) {
-    ++number;
-    const auto hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    std::istringstream fields(line);
-    std::string head;
-    if (!(fields >> head)) continue;
-    if (remaining > 0) {
-      double v[9];
-      std::istringstream values(line);
-      for (double& value : v) {
-        std::string token;
-        if (!(values >> token)) fail("expected 9 numbers (x y z c00 c01 c02 c11 c12 c22)");
-        try {
-          value = std::stod(token);  // "nan" is accepted here; unusable points are dropped later
-        } catch (const std::exception&) {
-          fail("'" + token + "' is not a number");
-        }
-      }
-      Eigen::Matrix3d c;
-      c << v[3], v[4], v[5], v[4], v[6], v[7], v[5], v[7], v[8];
-      block->Add({v[0], v[1], v[2]}, c);
-      --remaining;
-      continue;
-    }
-    if (head == "R" || head == "t") {
-      const int n = head == "R" ? 9 : 3;
-      double v[9];
-      for (int i = 0; i < n; ++i) {
-        if (!(fields >> v[i])) fail("'" + head + "' needs " + std::to_string(n) + " numbers");
-      }
-      if (head == "R") {
-        pair.truth.linear() << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
-        have_r = true;
+namespace {
+
+// Reads a pair file line by line, every error naming the file and the line.
+class PairReader {
+ public:
+  explicit PairReader(std::string path) : path_(std::move(path)) {}
+
+  RegistrationPair Read() {
+    std::ifstream in(path_);
+    if (!in) throw InputError(path_, "cannot open the pair file");
+    pair_.name = fs::path(path_).stem().string();
+    std::string line;
+    while (std::getline(in, line)) {
+      ++line_;
+      const auto hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream fields(line);
+      std::string head;
+      if (!(fields >> head)) continue;
+      if (remaining_ > 0) {
+        PointLine(line);
       } else {
-        pair.truth.translation() << v[0], v[1], v[2];
-        have_t = true;
+        if (!seen_.insert(head).second) Fail("'" + head + "' appears twice");
+        HeaderLine(head, fields);
       }
+    }
+    if (remaining_ > 0) throw InputError(path_, "ends " + std::to_string(remaining_) + " points early");
+    if (!seen_.count("R") || !seen_.count("t")) throw InputError(path_, "has no ground truth (lines R and t)");
+    if (pair_.x.empty() || pair_.y.empty()) throw InputError(path_, "needs both an X and a Y block");
+    return std::move(pair_);
+  }
+
+ private:
+  [[noreturn]] void Fail(const std::string& problem) const {
+    throw InputError(path_, "line " + std::to_string(line_) + ": " + problem);
+  }
+
+  // The whole token must be the number; points may be NaN (the data set marks unusable ones so),
+  // the truth may not.
+  double Number(std::istringstream& fields, const std::string& what, bool allow_nan) const {
+    std::string token;
+    if (!(fields >> token)) Fail("expected " + what);
+    if (allow_nan && (token == "nan" || token == "NaN" || token == "-nan")) return std::nan("");
+    const auto value = ParseFiniteNumber(token);
+    if (!value) Fail("'" + token + "' is not a finite number (" + what + ")");
+    return *value;
+  }
+
+  void PointLine(const std::string& line) {
+    std::istringstream values(line);
+    double v[9];
+    for (double& value : v) value = Number(values, "9 numbers (x y z c00 c01 c02 c11 c12 c22)", true);
+    std::string extra;
+    if (values >> extra) Fail("more than 9 numbers on a point line");
+    Eigen::Matrix3d c;
+    c << v[3], v[4], v[5], v[4], v[6], v[7], v[5], v[7], v[8];
+    block_->Add({v[0], v[1], v[2]}, c);
+    --remaining_;
+  }
+
+  void HeaderLine(const std::string& head, std::istringstream& fields) {
+    if (head == "R") {
+      Eigen::Matrix3d R;
+      for (int i = 0; i < 9; ++i) R(i / 3, i % 3) = Number(fields, "'R' with 9 numbers", false);
+      // A matrix that is no rotation would be scored by the clamp in the rotation error as a pass.
+      if ((R * R.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0.0) {
+        Fail("'R' is not a rotation (orthonormal with determinant +1)");
+      }
+      pair_.truth.linear() = R;
+    } else if (head == "t") {
+      for (int i = 0; i < 3; ++i) pair_.truth.translation()[i] = Number(fields, "'t' with 3 numbers", false);
+      if (pair_.truth.translation().norm() > 1e4) Fail("'t' is beyond 10 km");
+    } else if (head == "covariances") {
+      std::string kind;
+      if (!(fields >> kind) || (kind != "metric" && kind != "relative")) {
+        Fail("'covariances' is followed by metric (m^2) or relative (weights)");
+      }
+      pair_.relative_covariances = kind == "relative";
     } else if (head == "X" || head == "Y") {
-      if (!(fields >> remaining) || remaining < 0) fail("'" + head + "' needs a point count");
-      block = head == "X" ? &pair.x : &pair.y;
+      std::string count;
+      fields >> count;
+      const auto points = ParseInteger(count, 1, 10000000);
+      if (!points) Fail("'" + head + "' needs a point count in [1, 10000000], got '" + count + "'");
+      remaining_ = static_cast<long>(*points);
+      block_ = head == "X" ? &pair_.x : &pair_.y;
     } else {
-      fail("unexpected '" + head + "' (expected R, t, X or Y)");
+      Fail("unexpected '" + head + "' (expected covariances, R, t, X or Y)");
     }
   }
-  if (remaining > 0) throw InputError(path, "ends " + std::to_string(remaining) + " points early");
-  if (!have_r || !have_t) throw InputError(path, "has no ground truth (lines R and t)");
-  if (pair.x.empty() || pair.y.empty()) throw InputError(path, "needs both an X and a Y block");
-  return pair;
+
+  std::string path_;
+  RegistrationPair pair_;
+  std::set<std::string> seen_;  // each of R, t, X, Y, covariances once
+  int line_ = 0;
+  perception::PointCloud* block_ = nullptr;
+  long remaining_ = 0;
+};
+
+struct RegisterOptions {
+  std::string folder;
+  std::string method = "dugma";
+  std::vector<std::string> exclude;
+  int folds = 0;
+  int thin_target = 1, thin_source = 1;
+  perception::RegistrationOptions registration;
+};
+
+// The folder's pairs, each bad file reported on stderr and counted in `bad_files`.
+std::vector<RegistrationPair> LoadPairFolder(const RegisterOptions& options, int* bad_files) {
+  if (!fs::is_directory(options.folder)) throw InputError(options.folder, "not a folder");
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(options.folder)) {
+    if (entry.path().extension() == ".txt") files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError(options.folder, "holds no .txt pair files");
+  std::vector<RegistrationPair> pairs;
+  for (const auto& file : files) {
+    const std::string name = fs::path(file).stem().string();
+    if (std::find(options.exclude.begin(), options.exclude.end(), name) != options.exclude.end()) continue;
+    try {
+      pairs.push_back(Thinned(LoadRegistrationPair(file), options.thin_target, options.thin_source));
+    } catch (const InputError& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      ++*bad_files;
+    }
+  }
+  if (pairs.empty()) throw InputError(options.folder, "no usable pair left to register");
+  return pairs;
 }
 
+// A bad pair file is reported and the others are still registered; the exit code says so.
+int RunRegister(const RegisterOptions& options) {
+  perception::RegistrationOptions registration = options.registration;
+  registration.method = options.method == "icp"         ? perception::RegistrationMethod::kIcpPointToPoint
+                        : options.method == "icp_plane" ? perception::RegistrationMethod::kIcpPointToPlane
+                        : options.method == "gicp"      ? perception::RegistrationMethod::kGeneralizedIcp
+                                                        : perception::RegistrationMethod::kDugma;
+  registration.check_consistency = true;  // say which results are not to be trusted
+  registration.max_variance = 1e5;        // the data set's 1e6 entries mark unusable points
+  int bad_files = 0;
+  const std::vector<RegistrationPair> pairs = LoadPairFolder(options, &bad_files);
+  if (options.folds > static_cast<int>(pairs.size())) {
+    throw InputError(options.folder, "fewer pairs than --cross-validate folds");
+  }
+  int unregistered = 0;
+  if (options.folds > 0) {
+    CrossValidateDugma(pairs, options.folds, registration, std::cout);
+  } else {
+    unregistered = RegisterEach(pairs, registration, options.method, std::cout);
+  }
+  if (bad_files + unregistered > 0) {
+    std::cerr << bad_files << " pair file(s) could not be read, " << unregistered << " pair(s) could not be registered\n";
+  }
+  return bad_files + unregistered > 0 ? kExitBadInput : kExitSuccess;
+}
+
+}  // namespace
+
+RegistrationPair LoadRegistrationPair(const std::string& path) { return PairReader(path).Read(); }
+
 void AddRegistrationCommand(CLI::App& app, int& exit_code) {
-  struct Options {
-    std::string folder;
-    std::string method = "dugma";
-    std::vector<std::string> exclude;
-    int folds = 0;
-    int thin_target = 1, thin_source = 1;
-    perception::RegistrationOptions registration;
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<RegisterOptions>();
   auto* command = app.add_subcommand(
       "register", "register point-cloud pairs (DUGMA data set format) and report errors against ground truth");
   command->add_option("folder", options->folder, "folder of pair_NN.txt files")->required();
@@ -161,46 +267,16 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
                       "K: choose DUGMA's parameters on K-1 folds of the pairs, report each pair from its own fold")
       ->check(CLI::Range(2, 1000));
   auto& r = options->registration;
-  command->add_option("--iterations", r.max_iterations, "most EM / ICP iterations")->check(CLI::PositiveNumber);
+  command->add_option("--iterations", r.max_iterations, "most EM / ICP iterations")->check(CLI::Range(1, 100000));
   command->add_option("--neighbours", r.neighbours, "target points per source point (DUGMA)")->check(CLI::Range(1, 64));
-  command->add_option("--anneal-start", r.anneal_start, "initial spread in m (<0: from the misalignment)");
+  command->add_option("--anneal-start", r.anneal_start, "initial spread in m (<0: from the misalignment)")
+      ->check(CLI::Range(-1.0, 10.0));
   command->add_option("--anneal-factor", r.anneal_factor, "spread factor per iteration")->check(CLI::Range(0.1, 0.99));
-  command->add_option("--outlier-weight", r.outlier_weight, "weight of the outlier term")->check(CLI::NonNegativeNumber);
-  command->callback([options, &exit_code]() {
-    if (!fs::is_directory(options->folder)) throw InputError(options->folder, "not a folder");
-    std::vector<std::string> files;
-    for (const auto& entry : fs::directory_iterator(options->folder)) {
-      if (entry.path().extension() == ".txt") files.push_back(entry.path().string());
-    }
-    std::sort(files.begin(), files.end());
-    if (files.empty()) throw InputError(options->folder, "holds no .txt pair files");
-
-    perception::RegistrationOptions registration = options->registration;
-    registration.method = options->method == "icp"         ? perception::RegistrationMethod::kIcpPointToPoint
-                          : options->method == "icp_plane" ? perception::RegistrationMethod::kIcpPointToPlane
-                          : options->method == "gicp"      ? perception::RegistrationMethod::kGeneralizedIcp
-                                                           : perception::RegistrationMethod::kDugma;
-    registration.relative_covariances = true;  // the data set's covariances are relative weights
-    registration.check_consistency = true;     // say which results are not to be trusted
-    registration.max_variance = 1e5;           // its 1e6 entries mark unusable points
-
-    std::vector<RegistrationPair> pairs;
-    for (const auto& file : files) {
-      RegistrationPair pair = Thinned(LoadRegistrationPair(file), options->thin_target, options->thin_source);
-      if (std::find(options->exclude.begin(), options->exclude.end(), pair.name) == options->exclude.end()) {
-        pairs.push_back(std::move(pair));
-      }
-    }
-    if (options->folds > static_cast<int>(pairs.size())) {
-      throw InputError(options->folder, "fewer pairs than --cross-validate folds");
-    }
-    if (options->folds > 0) {
-      CrossValidateDugma(pairs, options->folds, registration, std::cout);
-    } else {
-      RegisterEach(pairs, registration, options->method, std::cout);
-    }
-    exit_code = 0;
-  });
+  command->add_option("--surface-spacings", r.surface_spacings,
+                      "spread along the surface, in point spacings (DUGMA; 0: covariances as given)")
+      ->check(CLI::Range(0.0, 1000.0));
+  command->add_option("--outlier-weight", r.outlier_weight, "weight of the outlier term")->check(CLI::Range(0.0, 1e6));
+  command->callback([options, &exit_code]() { exit_code = RunRegister(*options); });
 }
 
 void AddRegistrationSetCommand(CLI::App& app, int& exit_code) {
@@ -215,6 +291,9 @@ void AddRegistrationSetCommand(CLI::App& app, int& exit_code) {
   command->add_option("--garden", options->set.garden, "garden name or file")->capture_default_str();
   command->add_option("--pairs", options->set.pairs, "pairs to render")->check(CLI::Range(1, 10000))->capture_default_str();
   command->add_option("--seed", options->set.seed, "viewpoints and noise")->capture_default_str();
+  command->add_option("--crop-margin", options->set.crop_margin,
+                      "m of ground kept around the object (as in the DUGMA set); < 0 keeps the whole view")
+      ->capture_default_str();
   command->add_option("--out", options->out, "folder for render_NNN.txt")->required();
   command->callback([options, &exit_code]() {
     fs::create_directories(options->out);

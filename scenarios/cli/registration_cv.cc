@@ -20,15 +20,15 @@ struct Candidate {
 std::vector<Candidate> Grid(const perception::RegistrationOptions& base) {
   std::vector<Candidate> grid;
   for (int neighbours : {6, 10, 16}) {
-    for (double anneal : {0.85, 0.9, 0.95}) {
+    for (double surface : {4.0, 10.0, 30.0}) {
       for (double outlier : {0.03, 0.1, 0.3}) {
         Candidate c{base, ""};
         c.options.method = perception::RegistrationMethod::kDugma;
         c.options.neighbours = neighbours;
-        c.options.anneal_factor = anneal;
+        c.options.surface_spacings = surface;
         c.options.outlier_weight = outlier;
         std::ostringstream name;
-        name << "k" << neighbours << " a" << anneal << " w" << outlier;
+        name << "k" << neighbours << " s" << surface << " w" << outlier;
         c.name = name.str();
         grid.push_back(c);
       }
@@ -43,7 +43,7 @@ struct Outcome {
 
 Outcome Run(const RegistrationPair& pair, const perception::RegistrationOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), options);
+  const auto result = perception::Register(pair.x, pair.y, Eigen::Isometry3d::Identity(), ForPair(options, pair));
   return {RotationErrorDegrees(result.transform, pair.truth), TranslationError(result.transform, pair.truth),
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
 }

@@ -21,7 +21,7 @@ struct CrossValidationRow {
 };
 
 // `base`: the options every candidate starts from (method DUGMA); the grid varies neighbours,
-// anneal_factor and outlier_weight. Writes the table and summary to `out`; returns the rows.
+// surface_spacings and outlier_weight. Writes the table and summary to `out`; returns the rows.
 std::vector<CrossValidationRow> CrossValidateDugma(const std::vector<RegistrationPair>& pairs, int folds,
                                                    const perception::RegistrationOptions& base, std::ostream& out);
 

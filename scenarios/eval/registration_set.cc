@@ -29,9 +29,12 @@ class Draws {
   Rng rng_;
 };
 
-// The depth view back-projected into the camera's frame with Kinect-like noise and covariances.
+// The depth view back-projected into the camera's frame with Kinect-like noise and covariances,
+// cropped to the object and the ground around it (options.crop_margin).
 perception::PointCloud CloudFromDepth(const cv::Mat& depth, const robot::PinholeRadtan& camera,
+                                      const Eigen::Isometry3d& T_map_camera, const garden::GardenObject& object,
                                       const RegistrationSetOptions& options, Draws& draws) {
+  const double crop_radius = 0.5 * object.size.head<2>().norm() + options.crop_margin;
   perception::PointCloud cloud;
   for (int v = 0; v < depth.rows; v += options.stride) {
     for (int u = 0; u < depth.cols; u += options.stride) {
@@ -41,8 +44,10 @@ perception::PointCloud CloudFromDepth(const cv::Mat& depth, const robot::Pinhole
       const double axial = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
       const double lateral = kLateralPixels * z / camera.fx;
       const double noisy_z = z + axial * draws.Normal();
-      const Eigen::Vector3d point(ray.x() * noisy_z + lateral * draws.Normal(),
-                                  ray.y() * noisy_z + lateral * draws.Normal(), noisy_z);
+      const double noise_x = draws.Normal(), noise_y = draws.Normal();  // in order, whatever the compiler
+      const Eigen::Vector3d point(ray.x() * noisy_z + lateral * noise_x, ray.y() * noisy_z + lateral * noise_y, noisy_z);
+      const Eigen::Vector2d in_map = (T_map_camera * point).head<2>();
+      if (options.crop_margin >= 0.0 && (in_map - object.position).norm() > crop_radius) continue;
       cloud.Add(point, Eigen::Vector3d(lateral * lateral, lateral * lateral, axial * axial).asDiagonal());
     }
   }
@@ -93,8 +98,8 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
   for (int attempt = 0; static_cast<int>(pairs.size()) < options.pairs && attempt < 50 * options.pairs; ++attempt) {
     const garden::GardenObject& object = *objects[pairs.size() % objects.size()];
     const double bearing = draws.Uniform(-M_PI, M_PI);
-    const double turn = draws.Uniform(options.min_turn_deg, options.max_turn_deg) * M_PI / 180.0 *
-                        (draws.Uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0);
+    const double turn_deg = draws.Uniform(options.min_turn_deg, options.max_turn_deg);
+    const double turn = turn_deg * M_PI / 180.0 * (draws.Uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0);
     std::array<sim::Pose2D, 2> views;
     bool clear = true;
     for (int k = 0; k < 2; ++k) {
@@ -110,8 +115,9 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
     for (int k = 0; k < 2; ++k) {
       simulator.PlaceRobot(views[static_cast<size_t>(k)]);
       const sim::RingCapture capture = simulator.CaptureRing(request, true);
-      clouds[static_cast<size_t>(k)] = CloudFromDepth(capture.truth.views[kCamera].depth, camera, options, draws);
       T_map_camera[static_cast<size_t>(k)] = capture.truth.T_map_camera[kCamera];
+      clouds[static_cast<size_t>(k)] = CloudFromDepth(capture.truth.views[kCamera].depth, camera,
+                                                      T_map_camera[static_cast<size_t>(k)], object, options, draws);
     }
     if (clouds[0].size() < 100 || clouds[1].size() < 100) continue;
     RegistrationPair pair;
@@ -121,6 +127,7 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
     pair.x = std::move(clouds[0]);
     pair.y = std::move(clouds[1]);
     pair.truth = T_map_camera[0].inverse() * T_map_camera[1];  // x = truth * y
+    pair.relative_covariances = false;  // the noise model's variances, m^2
     pairs.push_back(std::move(pair));
   }
   return pairs;
@@ -128,7 +135,8 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
 
 void WriteRegistrationPair(const std::string& path, const RegistrationPair& pair) {
   std::ostringstream out;
-  out << std::setprecision(9) << "# rendered by trimbot register-set: x = R y + t\n";
+  out << std::setprecision(9) << "# rendered by trimbot register-set: x = R y + t\n"
+      << (pair.relative_covariances ? "covariances relative\n" : "covariances metric\n");
   const Eigen::Matrix3d& R = pair.truth.linear();
   out << "R " << R(0, 0) << ' ' << R(0, 1) << ' ' << R(0, 2) << ' ' << R(1, 0) << ' ' << R(1, 1) << ' ' << R(1, 2)
       << ' ' << R(2, 0) << ' ' << R(2, 1) << ' ' << R(2, 2) << '\n';

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "trimbot/perception/point_cloud.h"
+#include "trimbot/perception/registration.h"
 #include <Eigen/Geometry>
 #include "runner/world_setup.h"
 
@@ -19,7 +20,16 @@ struct RegistrationPair {
   std::string name;
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
   perception::PointCloud x, y;
+  // The DUGMA data set's covariances are relative weights; a file's line `covariances metric`
+  // says they are variances in m^2 (the rendered set's).
+  bool relative_covariances = true;
 };
+
+// `options` with the pair's own covariance convention.
+inline perception::RegistrationOptions ForPair(perception::RegistrationOptions options, const RegistrationPair& pair) {
+  options.relative_covariances = pair.relative_covariances;
+  return options;
+}
 
 struct RegistrationSetOptions {
   std::string garden = "test_lawn";
@@ -29,12 +39,16 @@ struct RegistrationSetOptions {
   double min_turn_deg = 10.0, max_turn_deg = 40.0;  // between the two viewpoints, about the object
   int stride = 4;                 // every stride-th pixel in each direction
   double max_depth = 4.0;         // m: farther pixels are left out (the Kinect's range)
+  // Each cloud keeps the object and the ground around it, as the DUGMA data set's clouds do (each
+  // a ~1.4 m square around a bush): points horizontally within the object's half-diagonal plus this
+  // margin of its centre. < 0 keeps the whole view (background, far ground, other objects).
+  double crop_margin = 0.5;
 };
 
 // Throws InputError naming the garden when it has no bush or object to look at.
 std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptions& options, const ProjectPaths& paths,
                                                       const std::string& work_dir);
-// `R`, `t`, then the X and Y blocks, as LoadRegistrationPair reads them.
+// `covariances metric`, `R`, `t`, then the X and Y blocks, as LoadRegistrationPair reads them.
 void WriteRegistrationPair(const std::string& path, const RegistrationPair& pair);
 
 }  // namespace trimbot::scenarios

@@ -4,6 +4,7 @@
 #include "open3d_icp.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <nanoflann.hpp>
 
@@ -144,6 +145,32 @@ void ScaleRelativeCovariances(double spacing, PointCloud* cloud) {
   for (auto& c : cloud->covariances) c *= scale;
 }
 
+// Each point's covariance as a surface patch: its variance across the local plane (the normal of
+// its 10 nearest neighbours) kept, `along` standard deviation within the plane.
+void SurfaceCovariances(double along, PointCloud* cloud) {
+  TargetLevel level;
+  level.cloud = *cloud;
+  level.Build();
+  const Eigen::Matrix3d in_plane_unit = Eigen::Matrix3d::Identity();
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    std::uint32_t index[10];
+    double d2[10];
+    const std::size_t found = level.tree->knnSearch(cloud->points[i].data(), 10, index, d2);
+    if (found < 3) continue;  // no plane to speak of: the covariance stays as given
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::size_t n = 0; n < found; ++n) mean += cloud->points[index[n]];
+    mean /= static_cast<double>(found);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (std::size_t n = 0; n < found; ++n) {
+      const Eigen::Vector3d d = cloud->points[index[n]] - mean;
+      scatter += d * d.transpose();
+    }
+    const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+    const Eigen::Matrix3d across = normal * normal.transpose();
+    cloud->covariances[i] = along * along * (in_plane_unit - across) + normal.dot(cloud->covariances[i] * normal) * across;
+  }
+}
+
 // The clouds as registration uses them: cleaned, covariances scaled, and a pyramid of voxel
 // levels of the target (with a k-d tree each) and of the source.
 struct Prepared {
@@ -174,15 +201,20 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
   // Median spacing of the target (nearest other point), the scale of "close".
   p->point_spacing = MedianSpacing(target, tree);
 
+  TargetLevel source_level;
+  source_level.cloud = source;
+  source_level.Build();
+  const double source_spacing = MedianSpacing(source, *source_level.tree);
   if (options.relative_covariances) {
     // Relative weights become variances with each cloud's own density: a sparse cloud's points
     // stand for more surface than a dense one's (with the target's scale for both, a target thinned
     // to ~500 points left the median error at 2.0 deg on the shared pairs).
-    TargetLevel source_level;
-    source_level.cloud = source;
-    source_level.Build();
     ScaleRelativeCovariances(p->point_spacing, &target);
-    ScaleRelativeCovariances(MedianSpacing(source, *source_level.tree), &source);
+    ScaleRelativeCovariances(source_spacing, &source);
+  }
+  if (options.method == RegistrationMethod::kDugma && options.surface_spacings > 0.0) {
+    SurfaceCovariances(options.surface_spacings * p->point_spacing, &target);
+    SurfaceCovariances(options.surface_spacings * source_spacing, &source);
   }
   for (const auto& c : target.covariances) p->isotropic = p->isotropic && IsIsotropic(c);
   for (const auto& c : source.covariances) p->isotropic = p->isotropic && IsIsotropic(c);

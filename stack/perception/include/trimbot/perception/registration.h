@@ -38,8 +38,15 @@ struct RegistrationOptions {
   double anneal_start = -1.0;
   double anneal_factor = 0.9;       // per iteration
   // Covariances given as relative weights (as in the DUGMA Kinect data set) are scaled so that
-  // the median point variance equals the squared median point spacing of the target.
+  // each cloud's median point variance equals the square of its own median point spacing.
   bool relative_covariances = false;
+  // Surface patches (DUGMA): two clouds sample a surface at different places, so their points do
+  // not correspond one to one and only the distance across the surface is evidence. Each point's
+  // covariance keeps its variance along the local normal (from its 10 nearest neighbours in its
+  // own cloud) and gets a standard deviation of `surface_spacings` point spacings along the surface
+  // (as generalized ICP's plane-to-plane term). Without it, partial views of a rounded bush pulled
+  // DUGMA off the truth even when started on it. 0 keeps the covariances as given.
+  double surface_spacings = 10.0;
   double max_variance = 1e4;        // m^2 (or relative units); larger marks an unusable point
   // Register the pair both ways and call the result untrusted when the two disagree by more than
   // max_inconsistency_deg (twice the time). If both were within 5 deg of the truth they would
