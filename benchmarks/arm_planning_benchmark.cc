@@ -39,7 +39,8 @@ struct Setup {
     for (double el = -1.2; el <= 1.4; el += 0.025) {
       for (double az = M_PI / 2; az <= 3 * M_PI / 2; az += 0.025) {
         const Eigen::Vector3d unit(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-        const double noise = 0.01 * (uniform() + uniform() + uniform() - 1.5) * 2.0;
+        const double u1 = uniform(), u2 = uniform(), u3 = uniform();  // drawn in order
+        const double noise = 0.01 * (u1 + u2 + u3 - 1.5) * 2.0;
         points.push_back(kBushCentre + kBushRadii.cwiseProduct(unit) + noise * unit);
       }
     }

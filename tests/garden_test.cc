@@ -69,7 +69,7 @@ TEST(Garden, BadFilesNameTheFileLineAndKey) {
                     "duplicate id 1");
   ExpectGardenError("negative.yaml",
                     head + "objects:\n  - {id: 1, class: rose, shape: box, size: [1, -1, 1], position: [0, 0]}\n",
-                    "all extents must be positive");
+                    "objects[0].size': each must be in [0.001, 200] m");
   ExpectGardenError("surface.yaml", "name: g\nsize: [10, 10]\nground: lava\nobjects: []\n", "unknown surface 'lava'");
   ExpectGardenError("no_objects.yaml", head, "key 'objects': missing");
   ExpectGardenError("not_yaml.yaml", "name: [g\n", "malformed YAML");

@@ -93,14 +93,15 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
   EXPECT_NE(message([&] { VisualMap::Load(dir + "/missing.sqlite"); }).find("not found"), std::string::npos);
 }
 
-// A map of the first 6 s of the lawn loop, built into `dir` (each test builds its own: ctest may
+// A map of the first 7 s of the lawn loop (~1 m of driving: 4 keyframes at the 0.3 m spacing),
+// built into `dir` (each test builds its own: ctest may
 // run them in any order, in parallel).
 scenarios::MapBuildOptions ShortLawnMap(const std::string& dir) {
   scenarios::MapBuildOptions options;
   options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
   options.out_dir = dir;
   options.paths = {TRIMBOT_SOURCE_DIR};
-  options.seconds = 6.0;
+  options.seconds = 7.0;
   return options;
 }
 

@@ -211,13 +211,13 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
   const struct {
     std::string replace, with, expected;
   } cases[] = {
-      {"goal_tolerance: 0.3", "goal_tolerence: 0.3", "goal_tolerence"},
+      {"goal_tolerance: 0.4", "goal_tolerence: 0.4", "goal_tolerence"},
       {"trials: 1", "trials: many", "trials"},
       {"time_limit: 60.0", "time_limit: 60.0\nfaults:\n  - {type: gremlins, start: 1.0}", "gremlins"},
       {"collisions: \\{max: 0\\}", "colisions: {max: 0}", "colisions"},
       {"success_rate: \\{min: 1.0\\}", "success_rate: {min: 1.0, max: 2.0}", "exactly one"},
-      {"goal_tolerance: 0.3", "goal_tolerance: -0.3", "goal_tolerance"},
-      {"goal_tolerance: 0.3", "goal_tolerance: 0.3\ngoal_tolerance: 0.4", "appears twice"},
+      {"goal_tolerance: 0.4", "goal_tolerance: -0.3", "goal_tolerance"},
+      {"goal_tolerance: 0.4", "goal_tolerance: 0.4\ngoal_tolerance: 0.5", "appears twice"},
       {"time_limit: 60.0", "time_limit: .inf", "finite"},
       {"position: 0.02", "position: -1", "initial_pose_sigma.position"},
       {"time_limit: 60.0", "time_limit: 60.0\nsurvey: {growth: 2}", "survey.growth"},

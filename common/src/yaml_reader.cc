@@ -1,5 +1,7 @@
 #include "trimbot/common/yaml_reader.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -62,7 +64,12 @@ T YamlMap::As(const std::string& key, const char* type_name) const {
   }
 }
 
-double YamlMap::Double(const std::string& key) const { return As<double>(key, "number"); }
+double YamlMap::Double(const std::string& key) const {
+  const double value = As<double>(key, "number");
+  // No key takes NaN or infinity: both pass every range check unnoticed (NaN < lo is false).
+  if (!std::isfinite(value)) Fail(key, "must be a finite number, got '" + node_[key].Scalar() + "'");
+  return value;
+}
 int YamlMap::Int(const std::string& key) const { return As<int>(key, "integer"); }
 bool YamlMap::Bool(const std::string& key) const { return As<bool>(key, "boolean"); }
 std::string YamlMap::String(const std::string& key) const { return As<std::string>(key, "string"); }
@@ -112,12 +119,32 @@ std::vector<double> YamlMap::Doubles(const std::string& key, int expected_size) 
     } catch (const YAML::Exception&) {
       Fail(key, "expected a list of numbers");
     }
+    if (!std::isfinite(out.back())) Fail(key, "must hold finite numbers, got '" + item.Scalar() + "'");
   }
   if (expected_size >= 0 && static_cast<int>(out.size()) != expected_size) {
     Fail(key, "expected " + std::to_string(expected_size) + " numbers, got " +
                   std::to_string(out.size()));
   }
   return out;
+}
+
+std::vector<double> YamlMap::Numbers(const std::string& key, int expected_size, double lo, double hi,
+                                     const std::string& unit) const {
+  const std::vector<double> values = Doubles(key, expected_size);
+  for (double value : values) {
+    if (value < lo || value > hi) {
+      std::ostringstream range;
+      range << "each must be in [" << lo << ", " << hi << "]" << (unit.empty() ? "" : " " + unit) << ", got " << value;
+      Fail(key, range.str());
+    }
+  }
+  return values;
+}
+
+std::string YamlMap::Name(const std::string& key) const {
+  const std::string name = String(key);
+  if (!IsPlainName(name)) Fail(key, "'" + name + "' is not a plain name (letters, digits, _ - . and not starting with .)");
+  return name;
 }
 
 Eigen::Vector3d YamlMap::Vector3(const std::string& key) const {

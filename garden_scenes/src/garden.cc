@@ -43,12 +43,12 @@ GardenObject ReadGardenObject(const YamlMap& item) {
   }
   object.object_class = *object_class;
   object.shape = ParseShape(item);
-  object.size = item.Vector3("size");
-  if (!(object.size.minCoeff() > 0.0)) item.Fail("size", "all extents must be positive");
-  const auto position = item.Doubles("position", 2);
+  const auto size = item.Numbers("size", 3, 1e-3, kMaxGardenExtent, "m");
+  object.size = {size[0], size[1], size[2]};
+  const auto position = item.Numbers("position", 2, -kMaxGardenExtent, kMaxGardenExtent, "m");
   object.position = {position[0], position[1]};
-  object.base_height = item.Double("base_height", 0.0);
-  object.yaw = item.Double("yaw_deg", 0.0) * kDegToRad;
+  object.base_height = item.NumberOr("base_height", 0.0, 0.0, kMaxGardenExtent, "m");
+  object.yaw = item.NumberOr("yaw_deg", 0.0, -360.0, 360.0, "deg") * kDegToRad;
   item.RejectUnknownKeys();
   return object;
 }
@@ -57,19 +57,18 @@ Garden Garden::Load(const std::string& path) {
   const YamlMap root = YamlMap::LoadFile(path);
   Garden garden;
   garden.source = path;
-  garden.name = root.String("name");
+  garden.name = root.Name("name");  // names output files: never a path
   if (root.Has("seed")) {
     const int seed = root.Integer("seed", 0, 2147483647);
     garden.appearance_seed = static_cast<std::uint64_t>(seed);
   } else {
     garden.appearance_seed = StreamSeed(0, "garden/" + garden.name);
   }
-  const auto size = root.Doubles("size", 2);
+  const auto size = root.Numbers("size", 2, 1.0, kMaxGardenExtent, "m");
   garden.size = {size[0], size[1]};
-  if (!(garden.size.x() > 0 && garden.size.y() > 0)) root.Fail("size", "must be positive");
   root.Has("description");  // free text for people
   if (root.Has("centre")) {
-    const auto centre = root.Doubles("centre", 2);
+    const auto centre = root.Numbers("centre", 2, -kMaxGardenExtent, kMaxGardenExtent, "m");
     garden.centre = {centre[0], centre[1]};
   }
   const std::string ground = root.String("ground");
@@ -77,8 +76,8 @@ Garden Garden::Load(const std::string& path) {
   if (!surface) root.Fail("ground", "unknown surface '" + ground + "' (grass, gravel, pavement, soil)");
   garden.ground = *surface;
 
-  garden.latitude = root.Double("latitude_deg", garden.latitude / kDegToRad) * kDegToRad;
-  garden.north = root.Double("north_deg", garden.north / kDegToRad) * kDegToRad;
+  garden.latitude = root.NumberOr("latitude_deg", garden.latitude / kDegToRad, -90.0, 90.0, "deg") * kDegToRad;
+  garden.north = root.NumberOr("north_deg", garden.north / kDegToRad, -360.0, 360.0, "deg") * kDegToRad;
   if (root.Has("paths")) {
     for (const YamlMap& item : root.MapList("paths")) {
       GroundPatch patch;
@@ -86,12 +85,11 @@ Garden Garden::Load(const std::string& path) {
       const auto surface = SurfaceFromString(surface_name);
       if (!surface) item.Fail("surface", "unknown surface '" + surface_name + "' (grass, gravel, pavement, soil)");
       patch.surface = *surface;
-      const auto centre = item.Doubles("centre", 2);
-      const auto size = item.Doubles("size", 2);
+      const auto centre = item.Numbers("centre", 2, -kMaxGardenExtent, kMaxGardenExtent, "m");
+      const auto size = item.Numbers("size", 2, 1e-3, kMaxGardenExtent, "m");
       patch.centre = {centre[0], centre[1]};
       patch.size = {size[0], size[1]};
-      if (!(patch.size.minCoeff() > 0.0)) item.Fail("size", "must be positive");
-      patch.yaw = item.Double("yaw_deg", 0.0) * kDegToRad;
+      patch.yaw = item.NumberOr("yaw_deg", 0.0, -360.0, 360.0, "deg") * kDegToRad;
       item.RejectUnknownKeys();
       garden.paths.push_back(patch);
     }

@@ -5,12 +5,15 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
+#include <optional>
 #include <iomanip>
 #include <random>
 #include <sstream>
 
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/parse_number.h"
 #include "trimbot/common/random.h"
 #include "trimbot/garden/object_mesh.h"
 
@@ -19,14 +22,18 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-ObjectClass ClassOfLabel(const std::string& label) {
+// GardenUI's label families; anything else is refused rather than guessed.
+std::optional<ObjectClass> ClassOfLabel(const std::string& label) {
   if (label.rfind("Topiary", 0) == 0) return ObjectClass::kTopiary;
   if (label.rfind("Hedge", 0) == 0) return ObjectClass::kHedge;
   if (label.rfind("Rose", 0) == 0) return ObjectClass::kRose;
   if (label == "Obstacle-Tree") return ObjectClass::kTree;
   if (label == "Obstacle-Trunk") return ObjectClass::kTrunk;
   if (label == "Obstacle-Fence" || label == "Obstacle-Post") return ObjectClass::kFence;
-  return ObjectClass::kObstacle;
+  for (const char* family : {"Obstacle", "Background", "Robot"}) {
+    if (label.rfind(family, 0) == 0) return ObjectClass::kObstacle;
+  }
+  return std::nullopt;
 }
 
 // Corners of an object's (or patch's) footprint rectangle in the map frame.
@@ -64,6 +71,7 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
   std::string line;
   int line_number = 0;
   Eigen::Vector2d low(1e9, 1e9), high(-1e9, -1e9);
+  std::set<int> ids;
   while (std::getline(in, line)) {
     ++line_number;
     if (line.empty() || line[0] == '#' || line.rfind("id,", 0) == 0) continue;
@@ -74,16 +82,32 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
       throw InputError(path, "line " + std::to_string(line_number) + ": expected 10 fields, got " + std::to_string(fields.size()));
     }
     GardenObject object;
-    try {
-      object.id = std::stoi(fields[0]);
-      object.size = {std::stod(fields[3]), std::stod(fields[4]), std::stod(fields[5])};
-      object.position = {std::stod(fields[6]), std::stod(fields[7])};
-      object.base_height = std::stod(fields[8]) - ground_z;
-      object.yaw = std::stod(fields[9]) * kDegToRad;
-    } catch (const std::exception&) {
-      throw InputError(path, "line " + std::to_string(line_number) + ": not a number where one is expected");
-    }
-    object.object_class = ClassOfLabel(fields[1]);
+    const auto fail = [&](const std::string& problem) {
+      throw InputError(path, "line " + std::to_string(line_number) + ": " + problem);
+    };
+    const auto number = [&](int field, const char* name, double lo, double hi) {
+      const auto value = ParseFiniteNumber(fields[static_cast<std::size_t>(field)]);
+      if (!value || *value < lo || *value > hi) {
+        std::ostringstream expected;
+        expected << name << " '" << fields[static_cast<std::size_t>(field)] << "' is not a number in [" << lo << ", "
+                 << hi << "]";
+        fail(expected.str());
+      }
+      return *value;
+    };
+    const auto id = ParseInteger(fields[0], 1, kMaxGardenObjectId);
+    if (!id) fail("id '" + fields[0] + "' is not a whole number in 1.." + std::to_string(kMaxGardenObjectId));
+    object.id = static_cast<int>(*id);
+    if (!ids.insert(object.id).second) fail("duplicate id " + std::to_string(object.id));
+    object.size = {number(3, "size_x", 1e-3, kMaxGardenExtent), number(4, "size_y", 1e-3, kMaxGardenExtent),
+                   number(5, "size_z", 1e-3, kMaxGardenExtent)};
+    object.position = {number(6, "pos_x", -kMaxGardenExtent, kMaxGardenExtent),
+                       number(7, "pos_y", -kMaxGardenExtent, kMaxGardenExtent)};
+    object.base_height = number(8, "pos_z", -kMaxGardenExtent, kMaxGardenExtent) - ground_z;
+    object.yaw = number(9, "yaw_deg", -360.0, 360.0) * kDegToRad;
+    const auto object_class = ClassOfLabel(fields[1]);
+    if (!object_class) fail("unknown label '" + fields[1] + "' (Topiary-*, Hedge-*, Rose-*, Obstacle-*, Background-*, Robot-*)");
+    object.object_class = *object_class;
     // GardenUI boxes are bounding boxes: topiary and tree crowns are round, roses and trunks cylinders.
     switch (object.object_class) {
       case ObjectClass::kTopiary:
@@ -98,6 +122,9 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
       object.size.z() += object.base_height;  // also for boxes reaching a little below the ground
       object.base_height = 0.0;
     }
+    if (!(object.size.z() > 0.0)) {
+      fail("object " + std::to_string(object.id) + " ends below the ground (is --ground-z the file's ground level?)");
+    }
     low = low.cwiseMin(object.position - object.size.head<2>() / 2);
     high = high.cwiseMax(object.position + object.size.head<2>() / 2);
     garden.objects.push_back(object);
@@ -110,8 +137,7 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
 
 Garden GenerateGarden(const GeneratorParameters& p) {
   Rng rng = MakeRng(p.seed, "garden_generator");
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * UniformUnit(rng); };
   Garden garden;
   garden.name = "generated_" + std::to_string(p.seed);
   garden.appearance_seed = StreamSeed(p.seed, "garden_appearance") >> 33;  // fits the file's 31-bit seed
@@ -179,12 +205,12 @@ Garden GenerateGarden(const GeneratorParameters& p) {
   for (int i = 0; i < p.hedges; ++i) {
     const double length = uniform(2.0, 5.0);
     place(make(ObjectClass::kHedge, Shape::kBox, {length, uniform(0.5, 0.8), uniform(0.4, 1.4)},
-               unit(rng) < 0.5 ? 0.0 : M_PI / 2),
+               UniformUnit(rng) < 0.5 ? 0.0 : M_PI / 2),
           p.robot_clearance);
   }
   for (int i = 0; i < p.topiary; ++i) {
     const double d = uniform(0.6, 0.9);
-    place(make(ObjectClass::kTopiary, unit(rng) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
+    place(make(ObjectClass::kTopiary, UniformUnit(rng) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
                {d, d * uniform(0.9, 1.1), d * uniform(0.6, 1.0)}),
           p.robot_clearance);
   }
@@ -261,7 +287,6 @@ void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const st
 void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2,
                          const std::string& path) {
   Rng rng = MakeRng(garden.appearance_seed, "ground_truth_ply");
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::ostringstream body;
   body << std::setprecision(6);
   long count = 0;
@@ -271,9 +296,9 @@ void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_
       const double area = 0.5 * (b - a).cross(d - a).norm();
       // Whole expected count plus a random remainder keeps the density exact on average.
       const double expected = area * points_per_m2;
-      const int n = static_cast<int>(expected) + (unit(rng) < expected - std::floor(expected) ? 1 : 0);
+      const int n = static_cast<int>(expected) + (UniformUnit(rng) < expected - std::floor(expected) ? 1 : 0);
       for (int k = 0; k < n; ++k) {
-        double u = unit(rng), v = unit(rng);
+        double u = UniformUnit(rng), v = UniformUnit(rng);
         if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
         const Eigen::Vector3d local = a + u * (b - a) + v * (d - a);
         const Eigen::Vector3d p = (pose * local.homogeneous()).head<3>();

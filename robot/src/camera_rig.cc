@@ -62,6 +62,8 @@ Eigen::Isometry3d ReadTransform(const YamlMap& cam, const std::string& key) {
     }
   }
   if (!ok) cam.Fail(key, "expected a 4x4 matrix of numbers");
+  if (!m.allFinite()) cam.Fail(key, "must hold finite numbers");
+  if (m.topRightCorner<3, 1>().norm() > 100.0) cam.Fail(key, "translation beyond 100 m");
   const Eigen::Matrix3d rotation = m.topLeftCorner<3, 3>();
   if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 ||
       rotation.determinant() < 0.0 || m.row(3).head<3>().norm() > 1e-9 || std::abs(m(3, 3) - 1.0) > 1e-9) {
@@ -103,20 +105,31 @@ CameraRig CameraRig::LoadKalibr(const std::string& path, const Eigen::Isometry3d
     PinholeRadtan& in = calibration.intrinsics;
     in.fx = k[0], in.fy = k[1], in.cx = k[2], in.cy = k[3];
     in.k1 = d[0], in.k2 = d[1], in.p1 = d[2], in.p2 = d[3];
+    for (double v : resolution) {
+      if (v != std::floor(v) || v < 16 || v > 16384) cam.Fail("resolution", "must be whole pixel counts in [16, 16384]");
+    }
     in.width = static_cast<int>(resolution[0]);
     in.height = static_cast<int>(resolution[1]);
-    if (in.width <= 0 || in.height <= 0) cam.Fail("resolution", "must be positive");
-    if (!(in.fx > 0.0) || !(in.fy > 0.0)) cam.Fail("intrinsics", "focal lengths must be positive");
-    for (double v : k) {
-      if (!std::isfinite(v)) cam.Fail("intrinsics", "must be finite");
+    // Numbers are finite (YamlMap); a focal length under 10 px or a principal point off the image
+    // is not a camera.
+    if (!(in.fx >= 10.0 && in.fx <= 1e5) || !(in.fy >= 10.0 && in.fy <= 1e5)) {
+      cam.Fail("intrinsics", "focal lengths must be in [10, 100000] px");
+    }
+    if (in.cx < 0.0 || in.cx > in.width || in.cy < 0.0 || in.cy > in.height) {
+      cam.Fail("intrinsics", "the principal point must lie on the image");
     }
     for (double v : d) {
-      if (!std::isfinite(v)) cam.Fail("distortion_coeffs", "must be finite");
+      if (std::abs(v) > 10.0) cam.Fail("distortion_coeffs", "must be in [-10, 10]");
     }
     calibration.rostopic = cam.String("rostopic", "");
-    cam.Has("cam_overlaps");
-    cam.Has("T_cam_imu");
-    cam.Has("timeshift_cam_imu");
+    // Kalibr's keys the twin does not use are still checked: a broken value means a broken file.
+    if (cam.Has("cam_overlaps")) {
+      for (double other : cam.Doubles("cam_overlaps")) {
+        if (other != std::floor(other) || other < 0 || other > 99) cam.Fail("cam_overlaps", "camera indices are whole numbers in [0, 99]");
+      }
+    }
+    if (cam.Has("T_cam_imu")) ReadTransform(cam, "T_cam_imu");
+    if (cam.Has("timeshift_cam_imu")) cam.Number("timeshift_cam_imu", -10.0, 10.0, "s");
     if (index == 0) {
       if (cam.Has("T_cn_cnm1")) cam.Fail("T_cn_cnm1", "cam0 has no previous camera");
       calibration.T_base_camera = T_base_cam0;

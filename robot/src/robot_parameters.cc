@@ -1,23 +1,17 @@
 #include "trimbot/robot/robot_parameters.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "trimbot/common/yaml_reader.h"
 
 namespace trimbot::robot {
 namespace {
 
-double Positive(const YamlMap& map, const std::string& key) {
-  const double value = map.Double(key);
-  if (!(value > 0.0)) map.Fail(key, "must be positive");
-  return value;
-}
-
-double NonNegative(const YamlMap& map, const std::string& key) {
-  const double value = map.Double(key);
-  if (!(value >= 0.0)) map.Fail(key, "must not be negative");
-  return value;
-}
+// Rates, noise densities, accelerations and speeds: positive (or non-negative) and below `hi`, a
+// bound far above any robot's but one that keeps 1e308 out.
+double Positive(const YamlMap& map, const std::string& key, double hi = 1e4) { return map.Number(key, 1e-12, hi); }
+double NonNegative(const YamlMap& map, const std::string& key, double hi = 1e3) { return map.Number(key, 0.0, hi); }
 
 }  // namespace
 
@@ -63,7 +57,7 @@ RobotParameters RobotParameters::Load(const std::string& path) {
   drive.RejectUnknownKeys();
 
   const YamlMap arm = root.Map("arm");
-  const auto home = arm.Doubles("home_position", 6);
+  const auto home = arm.Numbers("home_position", 6, -2.0 * M_PI, 2.0 * M_PI, "rad");
   std::copy(home.begin(), home.end(), config.arm_home_position.begin());
   arm.RejectUnknownKeys();
 

@@ -16,9 +16,9 @@ void AddBatchCommands(CLI::App& app, const std::string& data_root, int& exit_cod
   run->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
   run->add_option("--out", options->out_dir, "output folder")->required();
   auto* trials_option = run->add_option("--trials", *trials, "number of trials (default: the scenario's)")
-                            ->check(CLI::PositiveNumber);
+                            ->check(CLI::Range(1, 100000));
   auto* seed_option = run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
-  run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
+  run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
   run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
   run->add_option("--set", options->overrides,

@@ -12,6 +12,7 @@
 #include "runner/controllers.h"
 #include "runner/drive_plan.h"
 #include "trimbot/common/atomic_file.h"
+#include "trimbot/garden/garden.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
 
@@ -82,17 +83,19 @@ nlohmann::json Summary(const DriveOptions& options, const DrivePlan& plan, const
 }  // namespace
 
 int RunDrive(const DriveOptions& options) {
+  // The inputs are read and checked before the output folder is touched.
   const DrivePlan plan = DrivePlan::Load(options.plan_path);
+  const sim::SimulatorConfig config = PlantFor(options, plan, plan.world);
+  garden::Garden::Load(config.garden_path);
+  const stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
   const std::string out = options.output_dir;
   fs::create_directories(out);
-  const sim::SimulatorConfig config = PlantFor(options, plan, plan.world);
   const auto setup_start = Clock::now();
   sim::Simulator simulator(config);
   WriteFileAtomically(out + "/calibration/camchain.yaml", simulator.rig().ToKalibrYaml());
 
   // The stack listens (wheel odometry, EKF) from the plan's start; the plan drives.
-  stack::RobotStack listener(options.paths.robot_files(), stack::StackParameters::Load(options.paths.robot_files().stack_parameters),
-                             config.seed);
+  stack::RobotStack listener(options.paths.robot_files(), parameters, config.seed);
   listener.SetInitialPose(0.0, {plan.world.start.x, plan.world.start.y, plan.world.start.yaw});
   const double duration = std::min(plan.duration(), options.seconds.value_or(plan.duration()));
   DrivePlanPlayer player(plan, duration, &listener);

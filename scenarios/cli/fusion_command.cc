@@ -10,6 +10,7 @@
 #include "runner/controllers.h"
 #include "runner/drive_plan.h"
 #include "runner/world_setup.h"
+#include "trimbot/garden/garden.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
@@ -46,14 +47,16 @@ class PairPrinter : public Observer {
 };
 
 int RunFusion(const Options& options, const ProjectPaths& paths) {
+  // The inputs are read and checked before the output folder is touched.
   const DrivePlan plan = DrivePlan::Load(options.plan);
-  std::filesystem::create_directories(options.out);
   sim::SimulatorConfig config = MakeSimulatorConfig(paths, plan.world, options.out + "/world");
+  garden::Garden::Load(config.garden_path);
+  stack::StackParameters parameters = stack::StackParameters::Load(paths.robot_files().stack_parameters);
+  std::filesystem::create_directories(options.out);
   config.cameras_on_schedule = false;  // only the frames the stack's local fusion wants are rendered
   sim::Simulator simulator(config);
 
   // The stack listens with local fusion on; the plan drives.
-  stack::StackParameters parameters = stack::StackParameters::Load(paths.robot_files().stack_parameters);
   parameters.local_fusion = options.fusion;
   stack::RobotStack listener(paths.robot_files(), parameters, config.seed);
   listener.SetInitialPose(0.0, {plan.world.start.x, plan.world.start.y, plan.world.start.yaw});
@@ -89,9 +92,9 @@ void AddFusionCommand(CLI::App& app, const std::string& data_root, int& exit_cod
       "fusion", "register consecutive 360-degree stereo clouds of a drive (DUGMA from the odometry guess)");
   command->add_option("plan", options->plan, "drive plan (YAML)")->required();
   command->add_option("--out", options->out, "output folder")->required();
-  command->add_option("--interval", options->fusion.interval, "seconds between clouds")->check(CLI::PositiveNumber);
-  command->add_option("--clouds", options->clouds, "number of registrations")->check(CLI::PositiveNumber);
-  command->add_option("--stride", options->fusion.stride, "pixel stride of the stereo clouds")->check(CLI::PositiveNumber);
+  command->add_option("--interval", options->fusion.interval, "seconds between clouds")->check(CLI::Range(1e-3, 1e4));
+  command->add_option("--clouds", options->clouds, "number of registrations")->check(CLI::Range(1, 10000));
+  command->add_option("--stride", options->fusion.stride, "pixel stride of the stereo clouds")->check(CLI::Range(1, 64));
   command->add_option("--ground-keep", options->fusion.ground_keep, "fraction of ground points kept")
       ->check(CLI::Range(0.0, 1.0));
   command->callback([options, &data_root, &exit_code]() { exit_code = RunFusion(*options, ProjectPaths{data_root}); });

@@ -5,6 +5,7 @@
 
 #include "cli/batch_command.h"
 #include "cli/bench_command.h"
+#include "cli/cli_checks.h"
 #include "cli/compare_command.h"
 #include "cli/drive_command.h"
 #include "cli/fusion_command.h"
@@ -18,6 +19,9 @@
 int main(int argc, char** argv) {
   using namespace trimbot::scenarios;
   CLI::App app{"trimbot - simulation-backed digital twin of the TrimBot2020 garden robot"};
+  app.footer(
+      "Exit codes: 0 success; 1 a criterion or check failed; 2 bad input or usage (the file, key or argument is "
+      "named); 3 internal error.");
   app.require_subcommand(1);
   std::string data_root = ProjectPaths::Default().root;
   app.add_option("--data-root", data_root, "folder holding robot/, garden_scenes/ (default: the source tree)");
@@ -29,7 +33,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 0;
   auto* seed_option = drive_cmd->add_option("--seed", seed, "noise seed (default: the plan's)");
   double seconds = 0.0;
-  auto* seconds_option = drive_cmd->add_option("--seconds", seconds, "stop after this much simulated time");
+  auto* seconds_option = drive_cmd->add_option("--seconds", seconds, "stop after this much simulated time")
+                             ->check(CLI::Range(1e-3, 1e6));
   drive_cmd->add_option("--calibration", drive.calibration_path, "camera calibration (Kalibr camchain)");
   drive_cmd->add_option("--resolution-scale", drive.resolution_scale, "render at this fraction of 752x480")
       ->check(CLI::Range(0.1, 1.0));
@@ -43,8 +48,9 @@ int main(int argc, char** argv) {
   auto* bench_cmd = app.add_subcommand("bench", "measure rendering cost, physics speed and real-time factor");
   bench_cmd->add_option("--garden", bench.garden, "garden name or file");
   bench_cmd->add_option("--out", bench.output_path, "write the report as JSON here");
-  bench_cmd->add_option("--frames", bench.frames, "ring frames per measurement")->check(CLI::PositiveNumber);
-  bench_cmd->add_option("--drive-seconds", bench.drive_seconds, "simulated seconds of the drive measurement");
+  bench_cmd->add_option("--frames", bench.frames, "ring frames per measurement")->check(CLI::Range(1, 100000));
+  bench_cmd->add_option("--drive-seconds", bench.drive_seconds, "simulated seconds of the drive measurement")
+      ->check(CLI::Range(1e-3, 1e5));
 
   AddGardenCommands(app, data_root);
   int exit_code = 0;
@@ -57,12 +63,10 @@ int main(int argc, char** argv) {
   AddFusionCommand(app, data_root, exit_code);
   AddStereoCommand(app, data_root);
 
+  CheckEveryNumber(app);
+
   try {
-    try {
-      app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-      return app.exit(e);
-    }
+    if (const int parse_exit = ParseArguments(app, argc, argv); parse_exit >= 0) return parse_exit;
     if (drive_cmd->parsed()) {
       drive.paths = {data_root};
       if (seed_option->count() > 0) drive.seed = seed;
@@ -77,10 +81,9 @@ int main(int argc, char** argv) {
     return exit_code;
   } catch (const trimbot::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 2;
+    return kExitBadInput;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    std::fprintf(stderr, "internal error: %s\n", e.what());
+    return kExitInternalError;
   }
-  return 0;
 }

@@ -28,10 +28,10 @@ void AddEvalCommand(CLI::App* map, const std::string& name, const std::string& h
   auto* growth_option = command->add_option("--growth", *growth, "0..1 (default: the plan's)")->check(CLI::Range(0.0, 1.0));
   command->add_option("--lateral-offset", options->drive.lateral_offset, "m: drive this far left of the plan's start")
       ->check(CLI::Range(-5.0, 5.0));
-  command->add_option("--interval", options->drive.interval, "s between query frames")->check(CLI::PositiveNumber);
+  command->add_option("--interval", options->drive.interval, "s between query frames")->check(CLI::Range(1e-3, 1e4));
   auto seconds = std::make_shared<double>(0.0);
   auto* seconds_option = command->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
-                             ->check(CLI::PositiveNumber);
+                             ->check(CLI::Range(1e-3, 1e6));
   command->add_option("--resolution-scale", options->drive.resolution_scale,
                       "render at this fraction of 752x480 (default: the stack's visual_localization.image_scale)")
       ->check(CLI::Range(0.1, 1.0));
@@ -67,7 +67,7 @@ void AddMapCommands(CLI::App& app, const std::string& data_root, int& exit_code)
   build->add_option("--out", options->out_dir, "output folder (map.sqlite, map_stats.json, map_top_view.png)")->required();
   auto* seed_option = build->add_option("--seed", *seed, "seed of the drive and of the survey noise (default: the plan's)");
   auto* seconds_option = build->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
-                             ->check(CLI::PositiveNumber);
+                             ->check(CLI::Range(1e-3, 1e6));
   build->add_option("--survey-position-sigma", options->survey_position_sigma, "survey noise per axis (m)")
       ->check(CLI::Range(0.0, 1.0));
   build->add_option("--survey-rotation-sigma-deg", options->survey_rotation_sigma_deg, "survey rotation noise (deg)")

@@ -86,9 +86,9 @@ void AddStereoCommand(CLI::App& app, const std::string& data_root) {
   command->add_option("--out", options->output, "output folder")->required();
   command->add_flag("--dense", options->dense, "64 disparities, 8-path SGM (quality) instead of the robot's 32");
   command->add_option("--seed", options->seed, "seed of textures, foliage and image noise");
-  command->add_option("--x", options->x, "robot position in the map (m)");
-  command->add_option("--y", options->y, "robot position in the map (m)");
-  command->add_option("--yaw-deg", options->yaw_degrees, "robot heading in the map (degrees)");
+  command->add_option("--x", options->x, "robot position in the map (m)")->check(CLI::Range(-1e4, 1e4));
+  command->add_option("--y", options->y, "robot position in the map (m)")->check(CLI::Range(-1e4, 1e4));
+  command->add_option("--yaw-deg", options->yaw_degrees, "robot heading in the map (degrees)")->check(CLI::Range(-3600.0, 3600.0));
   command->add_option("--stride", options->stride, "use every n-th pixel for the cloud")->check(CLI::Range(1, 16));
   command->callback([options, &data_root] {  // data_root is read after --data-root is parsed
     const ProjectPaths paths{data_root};

@@ -17,9 +17,9 @@ void AddSweep(CLI::App& app, const std::string& data_root, int& exit_code) {
   sweep->add_option("--grid", options->grids, "key.path=v1,v2,... (repeatable; the product is swept)")->required();
   sweep->add_option("--out", options->out_dir, "output folder")->required();
   auto* trials_option = sweep->add_option("--trials", *trials, "trials per point (default: the scenario's)")
-                            ->check(CLI::PositiveNumber);
+                            ->check(CLI::Range(1, 100000));
   auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
-  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
+  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
   sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
   sweep->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
     options->paths = {data_root};
@@ -41,11 +41,11 @@ void AddTune(CLI::App& app, const std::string& data_root, int& exit_code) {
       ->required();
   tune->add_flag("--maximize", options->maximize, "maximize the objective (default: minimize)");
   tune->add_option("--method", options->method, "bobyqa (local) or direct (global DIRECT-L)");
-  tune->add_option("--budget", options->budget_trials, "trials the search may use")->check(CLI::PositiveNumber);
+  tune->add_option("--budget", options->budget_trials, "trials the search may use")->check(CLI::Range(1, 1000000));
   auto* trials_option = tune->add_option("--trials", *trials, "trials per evaluation (default: the scenario's)")
-                            ->check(CLI::PositiveNumber);
+                            ->check(CLI::Range(1, 100000));
   auto* seed_option = tune->add_option("--seed", *seed, "seed of the tuning trials (the same at every point)");
-  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::PositiveNumber);
+  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
   tune->add_option("--out", options->out_dir, "output folder")->required();
   tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
   tune->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {

@@ -48,8 +48,6 @@ class SimulatedPoseFixes {
   };
   SimulatedPoseFixParameters parameters_;
   Rng rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
-  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
   std::deque<Pending> pending_;
   double busy_until_ = -1.0;   // the pipeline processes one frame at a time
 };

@@ -70,6 +70,7 @@ BatchInfo ReadBatchInfo(const std::string& dir) {
     info.scenario_file = j.at("scenario_file").get<std::string>();
     info.seed = j.at("seed").get<std::uint64_t>();
     info.trials = j.at("trials").get<int>();
+    if (info.trials < 1 || info.trials > 100000) throw InputError(path, "'trials' must be in [1, 100000]");
     if (j.contains("overrides")) info.overrides = j.at("overrides").get<std::vector<std::string>>();
     std::tie(info.shard_index, info.shard_count) = ParseShard(j.at("shard").get<std::string>(), path);
     return info;
@@ -445,39 +446,61 @@ int RunBatch(const BatchOptions& options) {
   return WriteReports(out, scenario, map, WorldMap(scenario, options.paths), planned_goals, info, results, planned, log);
 }
 
+// `staged` becomes `target`: the folder it replaces is removed only once the new one is in place.
+void ReplaceFolder(const std::string& staged, const std::string& target) {
+  const std::string replaced = target + ".replaced";
+  fs::remove_all(replaced);
+  if (fs::exists(target)) fs::rename(target, replaced);
+  fs::rename(staged, target);
+  fs::remove_all(replaced);
+}
+
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths) {
   if (shard_dirs.empty()) throw InputError(out_dir, "merge needs at least one shard folder");
-  std::optional<BatchInfo> batch;
-  std::map<int, TrialResult> results;
-  fs::remove_all(out_dir + "/trials");  // no trial of an earlier merge may pass for one of this batch
-  fs::create_directories(out_dir + "/trials");
+  // Every shard is read and checked before anything is written: a missing, broken or foreign shard
+  // leaves out_dir as it was. The merge is built beside out_dir and swapped in at the end.
+  struct Shard {
+    std::string dir;
+    BatchInfo info;
+  };
+  std::vector<Shard> shards;
   std::string scenario_text;
   for (const auto& dir : shard_dirs) {
+    if (fs::exists(out_dir) && fs::exists(dir) && fs::equivalent(dir, out_dir)) {
+      throw InputError(out_dir, "the merged output cannot be one of the shards");
+    }
     const BatchInfo info = ReadBatchInfo(dir);
     const std::string text = ReadText(dir + "/scenario.yaml");
-    if (!batch) {
-      batch = info;
+    if (shards.empty()) {
       scenario_text = text;
-      WriteFileAtomically(out_dir + "/scenario.yaml", text);
-      fs::create_directories(out_dir + "/map");
-      fs::copy(dir + "/map", out_dir + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
-    } else if (info.seed != batch->seed || info.trials != batch->trials || info.shard_count != batch->shard_count ||
-               text != scenario_text) {
+    } else if (info.seed != shards.front().info.seed || info.trials != shards.front().info.trials ||
+               info.shard_count != shards.front().info.shard_count || text != scenario_text) {
       throw InputError(dir + "/batch.json", "belongs to another batch (scenario, seed, trials or shard count differ from " +
                                                  shard_dirs.front() + ")");
     }
-    for (int i = info.shard_index; i < info.trials; i += info.shard_count) {
-      const std::string trial_dir = TrialDir(dir, i);
+    shards.push_back({dir, info});
+  }
+
+  const std::string staging = out_dir + ".merging";
+  fs::remove_all(staging);
+  fs::create_directories(staging + "/trials");
+  WriteFileAtomically(staging + "/scenario.yaml", scenario_text);
+  fs::create_directories(staging + "/map");
+  fs::copy(shards.front().dir + "/map", staging + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+  std::map<int, TrialResult> results;
+  for (const Shard& shard : shards) {
+    for (int i = shard.info.shard_index; i < shard.info.trials; i += shard.info.shard_count) {
+      const std::string trial_dir = TrialDir(shard.dir, i);
       std::optional<TrialResult> result = ReadTrialResult(trial_dir);
       if (!result) continue;
-      fs::copy(trial_dir, TrialDir(out_dir, i), fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+      fs::copy(trial_dir, TrialDir(staging, i), fs::copy_options::overwrite_existing | fs::copy_options::recursive);
       results[i] = *result;
     }
   }
-  BatchInfo merged = *batch;
+  BatchInfo merged = shards.front().info;
   merged.shard_index = 0;
   merged.shard_count = 1;
-  WriteFileAtomically(out_dir + "/batch.json", ToJson(merged).dump(2));
+  WriteFileAtomically(staging + "/batch.json", ToJson(merged).dump(2));
   // Trials missing from the shards count as failed through trials_planned, as in a single run.
   std::vector<TrialResult> found;
   for (const auto& [index, result] : results) found.push_back(result);
@@ -485,10 +508,11 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
     std::cerr << "merge: " << merged.trials - static_cast<int>(found.size()) << " of " << merged.trials
               << " trials have no result in the shards; they count as failed\n";
   }
-  const Scenario scenario = Scenario::Load(out_dir + "/scenario.yaml");
-  return WriteReports(out_dir, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
-                      GoalPositions(MissionGoals(scenario, paths)), merged, found,
-                      merged.trials, std::cout);
+  const Scenario scenario = Scenario::Load(staging + "/scenario.yaml");
+  const int exit_code = WriteReports(staging, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
+                                     GoalPositions(MissionGoals(scenario, paths)), merged, found, merged.trials, std::cout);
+  ReplaceFolder(staging, out_dir);
+  return exit_code;
 }
 
 }  // namespace trimbot::scenarios

@@ -26,16 +26,17 @@ DrivePlan DrivePlan::Load(const std::string& path) {
   DrivePlan plan;
   plan.source = path;
   plan.world = WorldSetup::Read(root, /*with_seed=*/true);
-  plan.save_every_frames = root.Int("save_every_frames", 10);
-  if (plan.save_every_frames < 1) root.Fail("save_every_frames", "must be at least 1");
+  plan.save_every_frames = root.Has("save_every_frames") ? root.Integer("save_every_frames", 1, 1000000) : 10;
   for (const YamlMap& item : root.MapList("segments")) {
     DriveSegment segment;
-    segment.duration = item.Double("duration");
-    if (!(segment.duration > 0.0)) item.Fail("duration", "must be positive");
-    segment.linear = item.Double("linear");
-    segment.angular = item.Double("angular");
+    segment.duration = item.Number("duration", 1e-3, 1e5, "s");
+    segment.linear = item.Number("linear", -5.0, 5.0, "m/s");
+    segment.angular = item.Number("angular", -10.0, 10.0, "rad/s");
     if (item.Has("arm")) {
       const auto q = item.Doubles("arm", 6);
+      for (double angle : q) {
+        if (std::abs(angle) > 4.0 * M_PI) item.Fail("arm", "joint angles must be in [-4 pi, 4 pi] rad");
+      }
       segment.arm = std::array<double, 6>{q[0], q[1], q[2], q[3], q[4], q[5]};
     }
     segment.cutter = item.Bool("cutter", false);

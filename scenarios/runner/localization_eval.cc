@@ -111,12 +111,11 @@ class NoisyPrior {
  public:
   NoisyPrior(std::uint64_t seed, double sigma) : rng_(MakeRng(seed, "localization_eval_prior")), sigma_(sigma) {}
   Eigen::Vector2d operator()(const Eigen::Isometry3d& truth) {
-    return truth.translation().head<2>() + sigma_ * Eigen::Vector2d(normal_(rng_), normal_(rng_));
+    return truth.translation().head<2>() + sigma_ * StandardNormalVector<Eigen::Vector2d>(rng_);
   }
 
  private:
   Rng rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
   double sigma_;
 };
 

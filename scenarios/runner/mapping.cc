@@ -42,8 +42,8 @@ class SurveyPoses {
     auto it = poses_.find(truth.stamp);
     if (it != poses_.end()) return it->second;
     Eigen::Isometry3d pose = truth.T_map_base;
-    const Eigen::Vector3d dp(normal_(rng_), normal_(rng_), normal_(rng_));
-    const Eigen::Vector3d dr(normal_(rng_), normal_(rng_), normal_(rng_));
+    const auto dp = StandardNormalVector<Eigen::Vector3d>(rng_);
+    const auto dr = StandardNormalVector<Eigen::Vector3d>(rng_);
     pose.translation() += position_sigma_ * dp;
     const Eigen::Vector3d w = rotation_sigma_ * dr;
     pose.linear() = RotationFromVector(w) * pose.linear();
@@ -55,7 +55,6 @@ class SurveyPoses {
 
  private:
   Rng rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
   double position_sigma_, rotation_sigma_;
   std::map<double, Eigen::Isometry3d> poses_, truth_;
 };

@@ -42,13 +42,13 @@ garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey,
 }
 
 garden::OccupancyMap PriorMap(const Scenario& scenario, const ProjectPaths& paths) {
-  const garden::Garden built = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden built = garden::Garden::Load(ResolveGarden(scenario.world, paths));
   const garden::Garden surveyed = SurveyedGarden(built, scenario.survey, scenario.source);
   return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, scenario.map_clearance_height);
 }
 
 garden::OccupancyMap WorldMap(const Scenario& scenario, const ProjectPaths& paths) {
-  garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  garden::Garden world = garden::Garden::Load(ResolveGarden(scenario.world, paths));
   world.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
   as_grown.growth = scenario.world.conditions.growth;
@@ -94,7 +94,7 @@ perception::BushShape ShapeOf(const garden::GardenObject& object) {
 }  // namespace
 
 std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPaths& paths) {
-  const garden::Garden built = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden built = garden::Garden::Load(ResolveGarden(scenario.world, paths));
   const garden::Garden surveyed = SurveyedGarden(built, scenario.survey, scenario.source);
   std::vector<stack::Goal> goals;
   for (const ScenarioGoal& goal : scenario.goals) {
@@ -110,12 +110,12 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const ProjectPat
 
 void CheckArmReach(const Scenario& scenario, const ProjectPaths& paths) {
   if (!scenario.arm_reach) return;
-  const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden world = garden::Garden::Load(ResolveGarden(scenario.world, paths));
   BushOf(world, scenario.arm_reach->bush, scenario, "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
 }
 
 std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const ProjectPaths& paths) {
-  const garden::Garden world = garden::Garden::Load(garden::Garden::Resolve(scenario.world.garden, paths.gardens_dir()));
+  const garden::Garden world = garden::Garden::Load(ResolveGarden(scenario.world, paths));
   std::vector<GoalTruth> truths;
   for (const ScenarioGoal& goal : scenario.goals) {
     truths.push_back({goal.bush == 0 ? goal.position : BushOf(world, goal.bush, scenario, ApproachBush(goal.bush)).position, goal.bush});
@@ -131,8 +131,7 @@ std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals
 
 stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
   Rng rng = MakeRng(seed, "initial_pose");
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double dx = normal(rng), dy = normal(rng), dyaw = normal(rng);
+  const double dx = StandardNormal(rng), dy = StandardNormal(rng), dyaw = StandardNormal(rng);
   const sim::Pose2D& start = scenario.world.start;
   return {start.x + scenario.initial_position_sigma * dx, start.y + scenario.initial_position_sigma * dy,
           std::remainder(start.yaw + scenario.initial_yaw_sigma * dyaw, 2.0 * M_PI)};
@@ -141,9 +140,8 @@ stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
 namespace {
 
 Eigen::Isometry3d SmallMotion(Rng& rng, double rotation_sigma, double translation_sigma) {
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const Eigen::Vector3d w(normal(rng), normal(rng), normal(rng));
-  const Eigen::Vector3d t(normal(rng), normal(rng), normal(rng));
+  const auto w = StandardNormalVector<Eigen::Vector3d>(rng);
+  const auto t = StandardNormalVector<Eigen::Vector3d>(rng);
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   motion.linear() = RotationFromVector(rotation_sigma * w);
   motion.translation() = translation_sigma * t;
@@ -159,15 +157,14 @@ std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths
   if (!error.any()) return files.camchain;
   const robot::CameraRig truth = robot::LoadCameraRig(files);
   Rng rng = MakeRng(seed, "calibration_error");
-  std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<robot::CameraCalibration> cameras = truth.cameras();
   for (auto& camera : cameras) {
     auto& k = camera.intrinsics;
-    const double scale = 1.0 + error.focal_relative * normal(rng);
+    const double scale = 1.0 + error.focal_relative * StandardNormal(rng);
     k.fx *= scale;
     k.fy *= scale;
-    k.cx += error.principal_point_px * normal(rng);
-    k.cy += error.principal_point_px * normal(rng);
+    k.cx += error.principal_point_px * StandardNormal(rng);
+    k.cy += error.principal_point_px * StandardNormal(rng);
     const Eigen::Isometry3d motion = SmallMotion(rng, error.rotation_deg * M_PI / 180.0, error.translation_m);
     // cam0's pose on the robot comes from the URDF; the chain to the others is the camchain's.
     if (camera.index > 0) camera.T_base_camera = camera.T_base_camera * motion;

@@ -11,8 +11,10 @@
 namespace trimbot::scenarios {
 namespace {
 
-Eigen::Vector3d OptionalVector3(const YamlMap& map, const std::string& key) {
-  return map.Has(key) ? map.Vector3(key) : Eigen::Vector3d::Zero();
+Eigen::Vector3d OptionalVector3(const YamlMap& map, const std::string& key, double limit, const std::string& unit) {
+  if (!map.Has(key)) return Eigen::Vector3d::Zero();
+  const auto v = map.Numbers(key, 3, -limit, limit, unit);
+  return {v[0], v[1], v[2]};
 }
 
 sim::Fault ReadFault(const YamlMap& item) {
@@ -20,26 +22,23 @@ sim::Fault ReadFault(const YamlMap& item) {
   const std::string type = item.String("type");
   if (type == "wheel_slip") {
     fault.kind = sim::Fault::Kind::kWheelSlip;
-    fault.start = item.Double("start");
-    fault.duration = item.Double("duration");
-    fault.slip_left = item.Double("left", 0.0);
-    fault.slip_right = item.Double("right", 0.0);
-    if (fault.slip_left <= -1.0) item.Fail("left", "slip must be greater than -1");
-    if (fault.slip_right <= -1.0) item.Fail("right", "slip must be greater than -1");
+    fault.start = item.Number("start", 0.0, 1e6, "s");
+    fault.duration = item.Number("duration", 1e-3, 1e6, "s");
+    // A slip of -1 would stop the wheel's travel entirely; more than 10 times the travel is no slip.
+    fault.slip_left = item.NumberOr("left", 0.0, -0.99, 10.0);
+    fault.slip_right = item.NumberOr("right", 0.0, -0.99, 10.0);
   } else if (type == "imu_bias_jump") {
     fault.kind = sim::Fault::Kind::kImuBiasJump;
-    fault.start = item.Double("time");
-    fault.gyroscope_bias_jump = OptionalVector3(item, "gyro");
-    fault.accelerometer_bias_jump = OptionalVector3(item, "accel");
+    fault.start = item.Number("time", 0.0, 1e6, "s");
+    fault.gyroscope_bias_jump = OptionalVector3(item, "gyro", 10.0, "rad/s");
+    fault.accelerometer_bias_jump = OptionalVector3(item, "accel", 100.0, "m/s^2");
   } else if (type == "camera_dropout") {
     fault.kind = sim::Fault::Kind::kCameraDropout;
-    fault.start = item.Double("start");
-    fault.duration = item.Double("duration");
+    fault.start = item.Number("start", 0.0, 1e6, "s");
+    fault.duration = item.Number("duration", 1e-3, 1e6, "s");
   } else {
     item.Fail("type", "unknown fault '" + type + "' (wheel_slip, imu_bias_jump, camera_dropout)");
   }
-  if (fault.start < 0.0) item.Fail(type == "imu_bias_jump" ? "time" : "start", "must not be negative");
-  if (fault.kind != sim::Fault::Kind::kImuBiasJump && !(fault.duration > 0.0)) item.Fail("duration", "must be positive");
   item.RejectUnknownKeys();
   return fault;
 }
@@ -66,7 +65,9 @@ Survey ReadSurvey(const YamlMap& map) {
   survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
   if (map.Has("unmapped")) {
     for (double id : map.Doubles("unmapped")) {
-      if (id != std::floor(id) || id < 1) map.Fail("unmapped", "object ids are positive whole numbers");
+      if (id != std::floor(id) || id < 1 || id > garden::kMaxGardenObjectId) {
+        map.Fail("unmapped", "object ids are whole numbers in 1.." + std::to_string(garden::kMaxGardenObjectId));
+      }
       survey.unmapped.push_back(static_cast<int>(id));
     }
   }

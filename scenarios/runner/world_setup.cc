@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "trimbot/common/input_error.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/garden.h"
 
@@ -15,6 +16,7 @@ ProjectPaths ProjectPaths::Default() {
 
 WorldSetup WorldSetup::Read(const YamlMap& root, bool with_seed) {
   WorldSetup world;
+  world.source = root.file();
   world.garden = root.String("garden");
   const YamlMap start = root.Map("start");
   world.start.x = start.Number("x", -1e4, 1e4, "m");
@@ -30,11 +32,20 @@ WorldSetup WorldSetup::Read(const YamlMap& root, bool with_seed) {
   return world;
 }
 
+std::string ResolveGarden(const WorldSetup& world, const ProjectPaths& paths) {
+  try {
+    return garden::Garden::Resolve(world.garden, paths.gardens_dir());
+  } catch (const InputError& e) {
+    if (world.source.empty()) throw;
+    throw InputError(world.source, "key 'garden': " + e.problem());
+  }
+}
+
 sim::SimulatorConfig MakeSimulatorConfig(const ProjectPaths& paths, const WorldSetup& world,
                                          const std::string& world_dir) {
   sim::SimulatorConfig config;
   config.robot = paths.robot_files();
-  config.garden_path = garden::Garden::Resolve(world.garden, paths.gardens_dir());
+  config.garden_path = ResolveGarden(world, paths);
   config.world_dir = world_dir;
   config.seed = world.seed;
   config.start = world.start;

@@ -30,10 +30,14 @@ struct WorldSetup {
   sim::Pose2D start;              // true start pose of base_link (map frame)
   garden::Conditions conditions;  // time of day, season, growth
   std::uint64_t seed = 0;
+  std::string source;             // the file it was read from, for errors
 
   // Reads `garden`, `start`, `conditions` (and `seed` when `with_seed`) from a scenario or plan.
   static WorldSetup Read(const YamlMap& root, bool with_seed);
 };
+
+// The garden file of `world`; an unknown garden is an error naming the scenario or plan's key.
+std::string ResolveGarden(const WorldSetup& world, const ProjectPaths& paths);
 
 // The simulator configuration for `world` with the project's robot, composing its MuJoCo world in
 // `world_dir`; rendering, noise and faults at their defaults for the caller to set.

@@ -10,9 +10,9 @@ ImuModel::ImuModel(const robot::ImuNoise& noise, std::uint64_t seed) : noise_(no
 }
 
 Eigen::Vector3d ImuModel::Gaussian3() {
-  const double x = normal_(rng_);
-  const double y = normal_(rng_);
-  const double z = normal_(rng_);
+  const double x = StandardNormal(rng_);
+  const double y = StandardNormal(rng_);
+  const double z = StandardNormal(rng_);
   return {x, y, z};
 }
 

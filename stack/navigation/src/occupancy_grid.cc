@@ -15,15 +15,15 @@ namespace trimbot::stack {
 OccupancyGrid OccupancyGrid::LoadMapServer(const std::string& yaml_path) {
   const YamlMap yaml = YamlMap::LoadFile(yaml_path);
   const std::string image_name = yaml.String("image");
-  const double resolution = yaml.Double("resolution");
-  const std::vector<double> origin = yaml.Doubles("origin", 3);
-  const bool negate = yaml.Int("negate", 0) != 0;
-  yaml.Double("occupied_thresh", 0.65);
+  const double resolution = yaml.Number("resolution", 1e-3, 10.0, "m");
+  const std::vector<double> origin = yaml.Numbers("origin", 3, -1e4, 1e4, "m");
+  const bool negate = yaml.Has("negate") && yaml.Integer("negate", 0, 1) != 0;
+  const double occupied_thresh = yaml.NumberOr("occupied_thresh", 0.65, 0.0, 1.0);
   // Cells between free_thresh and occupied_thresh are unknown; the robot treats them as occupied.
-  const double free_thresh = yaml.Double("free_thresh", 0.196);
+  const double free_thresh = yaml.NumberOr("free_thresh", 0.196, 0.0, 1.0);
+  if (free_thresh > occupied_thresh) yaml.Fail("free_thresh", "must not exceed occupied_thresh");
   yaml.String("mode", "trinary");
   yaml.RejectUnknownKeys();
-  if (!(resolution > 0.0)) yaml.Fail("resolution", "must be positive");
 
   std::filesystem::path image_path(image_name);
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;

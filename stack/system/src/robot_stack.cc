@@ -525,8 +525,7 @@ void RobotStack::LocalizeVisually(const messages::RingFrame& frame) {
   const visual_localization::LocalizationResult result = c.localizer->Localize(frame, prior);
   const double measured = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const VisualLocalizationParameters& v = parameters_.visual;
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double drawn = std::min(v.latency_max, v.latency_median * std::exp(v.latency_log_sigma * normal(c.latency_rng)));
+  const double drawn = std::min(v.latency_max, v.latency_median * std::exp(v.latency_log_sigma * StandardNormal(c.latency_rng)));
   const double latency = v.measured_latency ? measured : drawn;
   localizer_busy_until_ = frame.stamp + latency;  // one frame at a time
   next_localization_ = frame.stamp + 1.0 / v.rate_hz;

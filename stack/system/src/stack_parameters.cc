@@ -8,7 +8,6 @@
 namespace trimbot::stack {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDegree = M_PI / 180.0;
 
 // Reads keys into fields that already hold their defaults. In a complete file every key must be
@@ -53,7 +52,7 @@ void ReadEkf(Reader& r, EkfParameters& p) {
   r.Number("wheel_speed_sigma", &p.wheel_speed_sigma, 1e-6, 10.0, "m/s");
   r.Number("wheel_slip_fraction", &p.wheel_slip_fraction, 0.0, 1.0);
   r.Number("gyro_sigma", &p.gyro_sigma, 1e-6, 10.0, "rad/s");
-  r.Number("fix_gate_chi2", &p.fix_gate_chi2, 0.0, kInf);
+  r.Number("fix_gate_chi2", &p.fix_gate_chi2, 0.0, 1e6);  // 1e6: every fix passes
   r.Integer("relocalize_after_rejections", &p.relocalize_after_rejections, 1, 1000);
   r.Number("relocalize_consistency", &p.relocalize_consistency, 0.0, 100.0, "m");
   r.Number("history_seconds", &p.history_seconds, 0.1, 60.0, "s");

@@ -36,4 +36,14 @@ inline double StandardNormal(Rng& rng) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
+// Independent standard normal draws, one per coefficient, in index order. (Function arguments are
+// evaluated in an unspecified order, so Vector3d(StandardNormal(rng), StandardNormal(rng), ...)
+// gives other coefficients with another compiler.)
+template <class Vector>
+Vector StandardNormalVector(Rng& rng) {
+  Vector v;
+  for (int i = 0; i < static_cast<int>(v.size()); ++i) v[i] = StandardNormal(rng);
+  return v;
+}
+
 }  // namespace trimbot

@@ -20,7 +20,7 @@ class YamlMap {
   YamlMap(YAML::Node node, std::string file, std::string path_in_file);
 
   bool Has(const std::string& key) const;
-  // Required values.
+  // Required values. Numbers are always finite (NaN and infinity are refused).
   double Double(const std::string& key) const;
   int Int(const std::string& key) const;
   bool Bool(const std::string& key) const;
@@ -39,6 +39,12 @@ class YamlMap {
   double Number(const std::string& key, double lo, double hi, const std::string& unit = "") const;
   double NumberOr(const std::string& key, double fallback, double lo, double hi, const std::string& unit = "") const;
   int Integer(const std::string& key, int lo, int hi) const;
+  // A list of exactly `expected_size` finite numbers, each within [lo, hi].
+  std::vector<double> Numbers(const std::string& key, int expected_size, double lo, double hi,
+                              const std::string& unit = "") const;
+  // A name that can become a file name: letters, digits, '_', '-', '.', not starting with '.'
+  // (so never "..", a path or a hidden file), at most 100 characters.
+  std::string Name(const std::string& key) const;
 
   // Throws InputError naming the first key that was never read. Call after reading all keys.
   void RejectUnknownKeys() const;

@@ -35,6 +35,10 @@ struct GroundPatch {
   double yaw = 0.0;
 };
 
+// The largest garden extent (and object extent or coordinate) a garden file may give, m: the
+// occupancy maps and renders grow with the square of it.
+constexpr double kMaxGardenExtent = 200.0;
+
 struct Garden {
   std::string name;
   std::string source;                       // file it was read from

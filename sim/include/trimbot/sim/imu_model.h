@@ -31,7 +31,6 @@ class ImuModel {
 
   robot::ImuNoise noise_;
   Rng rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
   Eigen::Vector3d accelerometer_bias_;
   Eigen::Vector3d gyroscope_bias_;
 };

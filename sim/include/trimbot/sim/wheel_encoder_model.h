@@ -38,7 +38,6 @@ class WheelEncoderModel {
 
   int ticks_per_revolution_;
   Rng rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
   Wheel left_, right_;
 };
 
