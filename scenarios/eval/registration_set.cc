@@ -133,25 +133,4 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
   return pairs;
 }
 
-void WriteRegistrationPair(const std::string& path, const RegistrationPair& pair) {
-  std::ostringstream out;
-  out << std::setprecision(9) << "# rendered by trimbot register-set: x = R y + t\n"
-      << (pair.relative_covariances ? "covariances relative\n" : "covariances metric\n");
-  const Eigen::Matrix3d& R = pair.truth.linear();
-  out << "R " << R(0, 0) << ' ' << R(0, 1) << ' ' << R(0, 2) << ' ' << R(1, 0) << ' ' << R(1, 1) << ' ' << R(1, 2)
-      << ' ' << R(2, 0) << ' ' << R(2, 1) << ' ' << R(2, 2) << '\n';
-  out << "t " << pair.truth.translation().x() << ' ' << pair.truth.translation().y() << ' '
-      << pair.truth.translation().z() << '\n';
-  for (const auto& [label, cloud] : {std::pair{"X", &pair.x}, std::pair{"Y", &pair.y}}) {
-    out << label << ' ' << cloud->size() << '\n';
-    for (std::size_t i = 0; i < cloud->size(); ++i) {
-      const Eigen::Vector3d& p = cloud->points[i];
-      const Eigen::Matrix3d& c = cloud->covariances[i];
-      out << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << c(0, 0) << ' ' << c(0, 1) << ' ' << c(0, 2) << ' '
-          << c(1, 1) << ' ' << c(1, 2) << ' ' << c(2, 2) << '\n';
-    }
-  }
-  WriteFileAtomically(path, out.str());
-}
-
 }  // namespace trimbot::scenarios

@@ -8,28 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "trimbot/perception/point_cloud.h"
-#include "trimbot/perception/registration.h"
-#include <Eigen/Geometry>
+#include "eval/registration_pair_file.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
-
-// Two clouds and the truth that maps the second onto the first: x = truth * y.
-struct RegistrationPair {
-  std::string name;
-  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
-  perception::PointCloud x, y;
-  // The DUGMA data set's covariances are relative weights; a file's line `covariances metric`
-  // says they are variances in m^2 (the rendered set's).
-  bool relative_covariances = true;
-};
-
-// `options` with the pair's own covariance convention.
-inline perception::RegistrationOptions ForPair(perception::RegistrationOptions options, const RegistrationPair& pair) {
-  options.relative_covariances = pair.relative_covariances;
-  return options;
-}
 
 struct RegistrationSetOptions {
   std::string garden = "test_lawn";
@@ -48,7 +30,5 @@ struct RegistrationSetOptions {
 // Throws InputError naming the garden when it has no bush or object to look at.
 std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptions& options, const ProjectPaths& paths,
                                                       const std::string& work_dir);
-// `covariances metric`, `R`, `t`, then the X and Y blocks, as LoadRegistrationPair reads them.
-void WriteRegistrationPair(const std::string& path, const RegistrationPair& pair);
 
 }  // namespace trimbot::scenarios
