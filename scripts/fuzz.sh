@@ -14,10 +14,11 @@ cmake --build "$build" -j "${BUILD_JOBS:-2}"
 echo "fuzz: the readers' unit tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 (cd "$build" && ./sanitized_reader_tests --gtest_brief=1)
 
-mkdir -p "$build/corpus/yaml" "$build/corpus/pair" "$build/findings"
+mkdir -p "$build/corpus/yaml" "$build/corpus/scenario" "$build/corpus/pair" "$build/findings"
 cp garden_scenes/gardens/*.yaml robot/config/robot_parameters.yaml robot/calibration/*.yaml "$build/corpus/yaml/"
+for file in scenarios/*/*.yaml; do cp "$file" "$build/corpus/scenario/$(echo "$file" | tr / _)"; done
 cp tests/fuzz/corpus/pair/* "$build/corpus/pair/"
-for run in "fuzz_yaml_inputs yaml" "fuzz_pair_file pair"; do
+for run in "fuzz_yaml_inputs yaml" "fuzz_scenario scenario" "fuzz_pair_file pair"; do
   set -- $run
   echo "fuzz: $1 for ${seconds} s"
   (cd "$build/findings" && "../$1" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
