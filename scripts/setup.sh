@@ -31,9 +31,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+# BUILD_DIR (default build/) and TRIMBOT_SANITIZE=ON (AddressSanitizer + UndefinedBehaviorSanitizer,
+# what scripts/run_tests.sh builds in build-asan/) choose the build.
 BUILD_DIR="${BUILD_DIR:-build}"
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
-  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIMBOT_SANITIZE="${TRIMBOT_SANITIZE:-OFF}"
 fi
 # Two cores: two compile jobs keep memory and time in check.
 cmake --build "$BUILD_DIR" -j "${BUILD_JOBS:-2}"
