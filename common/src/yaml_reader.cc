@@ -88,7 +88,6 @@ std::string YamlMap::String(const std::string& key, const std::string& fallback)
 double YamlMap::Number(const std::string& key, double lo, double hi, const std::string& unit) const {
   const double value = Double(key);
   const std::string suffix = unit.empty() ? "" : " " + unit;
-  if (!std::isfinite(value)) Fail(key, "must be a finite number");
   if (value < lo || value > hi) {
     std::ostringstream range;
     range << "must be in [" << lo << ", " << hi << "]" << suffix << ", got " << value;
@@ -137,6 +136,19 @@ std::vector<double> YamlMap::Numbers(const std::string& key, int expected_size, 
       range << "each must be in [" << lo << ", " << hi << "]" << (unit.empty() ? "" : " " + unit) << ", got " << value;
       Fail(key, range.str());
     }
+  }
+  return values;
+}
+
+std::vector<int> YamlMap::Integers(const std::string& key, int lo, int hi) const {
+  std::vector<int> values;
+  for (double value : Doubles(key)) {
+    if (value != std::floor(value) || value < lo || value > hi) {
+      std::ostringstream expected;
+      expected << "each must be a whole number in [" << lo << ", " << hi << "], got " << value;
+      Fail(key, expected.str());
+    }
+    values.push_back(static_cast<int>(value));
   }
   return values;
 }

@@ -123,11 +123,7 @@ CameraRig CameraRig::LoadKalibr(const std::string& path, const Eigen::Isometry3d
     }
     calibration.rostopic = cam.String("rostopic", "");
     // Kalibr's keys the twin does not use are still checked: a broken value means a broken file.
-    if (cam.Has("cam_overlaps")) {
-      for (double other : cam.Doubles("cam_overlaps")) {
-        if (other != std::floor(other) || other < 0 || other > 99) cam.Fail("cam_overlaps", "camera indices are whole numbers in [0, 99]");
-      }
-    }
+    if (cam.Has("cam_overlaps")) cam.Integers("cam_overlaps", 0, 99);
     if (cam.Has("T_cam_imu")) ReadTransform(cam, "T_cam_imu");
     if (cam.Has("timeshift_cam_imu")) cam.Number("timeshift_cam_imu", -10.0, 10.0, "s");
     if (index == 0) {

@@ -64,12 +64,7 @@ Survey ReadSurvey(const YamlMap& map) {
   Survey survey;
   survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
   if (map.Has("unmapped")) {
-    for (double id : map.Doubles("unmapped")) {
-      if (id != std::floor(id) || id < 1 || id > garden::kMaxGardenObjectId) {
-        map.Fail("unmapped", "object ids are whole numbers in 1.." + std::to_string(garden::kMaxGardenObjectId));
-      }
-      survey.unmapped.push_back(static_cast<int>(id));
-    }
+    survey.unmapped = map.Integers("unmapped", 1, garden::kMaxGardenObjectId);
   }
   if (map.Has("gone")) {
     for (const YamlMap& item : map.MapList("gone")) survey.gone.push_back(garden::ReadGardenObject(item));

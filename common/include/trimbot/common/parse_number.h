@@ -9,6 +9,14 @@
 
 namespace trimbot {
 
+// Whether nothing but spaces, tabs and a CR follow: the number was the whole field.
+inline bool OnlyBlanks(const char* rest) {
+  for (const char* c = rest; *c != '\0'; ++c) {
+    if (*c != ' ' && *c != '\t' && *c != '\r') return false;
+  }
+  return true;
+}
+
 inline std::optional<double> ParseFiniteNumber(const std::string& text) {
   const auto first = text.find_first_not_of(" \t\r");
   if (first == std::string::npos) return std::nullopt;
@@ -16,10 +24,7 @@ inline std::optional<double> ParseFiniteNumber(const std::string& text) {
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(begin, &end);
-  if (end == begin || errno == ERANGE || !std::isfinite(value)) return std::nullopt;
-  for (const char* c = end; *c != '\0'; ++c) {
-    if (*c != ' ' && *c != '\t' && *c != '\r') return std::nullopt;
-  }
+  if (end == begin || errno == ERANGE || !std::isfinite(value) || !OnlyBlanks(end)) return std::nullopt;
   return value;
 }
 
@@ -31,10 +36,7 @@ inline std::optional<long long> ParseInteger(const std::string& text, long long 
   char* end = nullptr;
   errno = 0;
   const long long value = std::strtoll(begin, &end, 10);
-  if (end == begin || errno == ERANGE || value < lo || value > hi) return std::nullopt;
-  for (const char* c = end; *c != '\0'; ++c) {
-    if (*c != ' ' && *c != '\t' && *c != '\r') return std::nullopt;
-  }
+  if (end == begin || errno == ERANGE || value < lo || value > hi || !OnlyBlanks(end)) return std::nullopt;
   return value;
 }
 

@@ -42,6 +42,8 @@ class YamlMap {
   // A list of exactly `expected_size` finite numbers, each within [lo, hi].
   std::vector<double> Numbers(const std::string& key, int expected_size, double lo, double hi,
                               const std::string& unit = "") const;
+  // A list of whole numbers (ids, indices), each within [lo, hi].
+  std::vector<int> Integers(const std::string& key, int lo, int hi) const;
   // A name that can become a file name: letters, digits, '_', '-', '.', not starting with '.'
   // (so never "..", a path or a hidden file), at most 100 characters.
   std::string Name(const std::string& key) const;
