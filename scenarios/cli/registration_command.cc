@@ -41,11 +41,11 @@ RegistrationPair Thinned(RegistrationPair pair, int target_every, int source_eve
 // One row per pair (sizes, errors, time, the EM's state, the both-ways check) and the medians.
 // Returns the number of pairs that could not be registered (too few usable points).
 int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::RegistrationOptions& registration,
-                 const std::string& method, std::ostream& out) {
+                 const std::string& method, bool show_starts, std::ostream& out) {
   out << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
       << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)" << std::setw(7)
       << "iters" << std::setw(10) << "time (s)" << std::setw(9) << "matched" << std::setw(6) << "conv" << std::setw(9)
-      << "cost" << std::setw(11) << "both ways" << "\n";
+      << "cost" << std::setw(11) << "both ways" << std::setw(9) << "on surf" << "\n";
   std::vector<double> rotation, translation, seconds;
   int under_5_degrees = 0;
   int unregistered = 0;
@@ -73,7 +73,16 @@ int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::R
         << std::setprecision(3) << std::setw(11) << t << std::setw(7) << result.iterations << std::setw(10) << time
         << std::setprecision(2) << std::setw(9) << result.matched_fraction << std::setw(6) << result.converged
         << std::setw(9) << result.final_cost << std::setw(11) << result.consistency_deg
-        << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
+        << std::setw(9) << result.on_surface << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
+    if (show_starts) {
+      for (std::size_t k = 0; k < result.starts.size(); ++k) {
+        const perception::RegistrationStart& start = result.starts[k];
+        out << "    start " << k << (static_cast<int>(k) == result.chosen_start ? " (chosen)" : "") << ": rotation "
+            << RotationErrorDegrees(start.transform, pair.truth) << " deg, translation "
+            << TranslationError(start.transform, pair.truth) << " m, on surface " << start.on_surface
+            << ", log-likelihood " << start.log_likelihood << "\n";
+      }
+    }
   }
   if (rotation.empty()) {
     out << "no pair registered (" << method << ")\n";
@@ -89,13 +98,22 @@ int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::R
 
 namespace {
 
+// The pairs are registered from the identity, so the guess's heading may be off by as much as the
+// views turn: 10-43 deg in both the DUGMA data set and the rendered set.
+perception::RegistrationOptions FromTheIdentity() {
+  perception::RegistrationOptions options;
+  options.heading_search_deg = 45.0;
+  return options;
+}
+
 struct RegisterOptions {
   std::string folder;
   std::string method = "dugma";
   std::vector<std::string> exclude;
   int folds = 0;
   int thin_target = 1, thin_source = 1;
-  perception::RegistrationOptions registration;
+  bool show_starts = false;
+  perception::RegistrationOptions registration = FromTheIdentity();
 };
 
 // The folder's pairs, each bad file reported on stderr and counted in `bad_files`.
@@ -140,7 +158,7 @@ int RunRegister(const RegisterOptions& options) {
   if (options.folds > 0) {
     CrossValidateDugma(pairs, options.folds, registration, std::cout);
   } else {
-    unregistered = RegisterEach(pairs, registration, options.method, std::cout);
+    unregistered = RegisterEach(pairs, registration, options.method, options.show_starts, std::cout);
   }
   if (bad_files + unregistered > 0) {
     std::cerr << bad_files << " pair file(s) could not be read, " << unregistered << " pair(s) could not be registered\n";
@@ -176,6 +194,15 @@ void AddRegistrationCommand(CLI::App& app, int& exit_code) {
   command->add_option("--surface-spacings", r.surface_spacings,
                       "spread along the surface, in point spacings (DUGMA; 0: covariances as given)")
       ->check(CLI::Range(0.0, 1000.0));
+  command->add_option("--heading-search", r.heading_search_deg,
+                      "deg: DUGMA also starts turned about the ground's normal within this range of the guess (0: "
+                      "one start)")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  command->add_option("--heading-step", r.heading_step_deg, "deg between the heading starts")
+      ->check(CLI::Range(1.0, 90.0))
+      ->capture_default_str();
+  command->add_flag("--show-starts", options->show_starts, "print each DUGMA start's errors and fit");
   command->add_option("--outlier-weight", r.outlier_weight, "weight of the outlier term")->check(CLI::Range(0.0, 1e6));
   command->callback([options, &exit_code]() { exit_code = RunRegister(*options); });
 }

@@ -20,7 +20,7 @@ struct Candidate {
 std::vector<Candidate> Grid(const perception::RegistrationOptions& base) {
   std::vector<Candidate> grid;
   for (int neighbours : {6, 10, 16}) {
-    for (double surface : {4.0, 10.0, 30.0}) {
+    for (double surface : {0.0, 4.0, 10.0}) {
       for (double outlier : {0.03, 0.1, 0.3}) {
         Candidate c{base, ""};
         c.options.method = perception::RegistrationMethod::kDugma;
