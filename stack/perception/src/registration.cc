@@ -14,6 +14,7 @@
 #include <cmath>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -471,6 +472,31 @@ constexpr std::size_t kFitPoints = 2000;
 // the views, but only to within its leaf clumps (centimetres); the truth fits to the sensor's
 // noise (millimetres), and this likelihood tells the two apart where a count of close points
 // does not (rendered set: 48 of 50 pairs against 37 of 50).
+// One point moved by T against `to`'s surface: its distance across the normal of its nearest point
+// of `to`, the variance of that distance (both points' along the normal) and its Gaussian density.
+// Nothing when no point of `to` lies within `reach` or that point has no normal.
+struct SurfaceResidual {
+  Eigen::Vector3d moved, normal;
+  double across = 0.0, variance = 0.0, density = 0.0;
+};
+
+std::optional<SurfaceResidual> ResidualOnSurface(const Eigen::Vector3d& point, const Eigen::Matrix3d& covariance,
+                                                 const TargetLevel& to, const LocalSurface& to_surface,
+                                                 const Eigen::Isometry3d& T, double reach) {
+  SurfaceResidual r;
+  r.moved = T * point;
+  std::uint32_t index;
+  double d2;
+  if (to.tree->knnSearch(r.moved.data(), 1, &index, &d2) != 1 || d2 > reach * reach) return std::nullopt;
+  r.normal = to_surface.normals[index];
+  if (r.normal.isZero()) return std::nullopt;
+  const Eigen::Vector3d moved_normal = T.linear().transpose() * r.normal;
+  r.variance = to_surface.normal_variances[index] + moved_normal.dot(covariance * moved_normal);
+  r.across = r.normal.dot(r.moved - to.cloud.points[index]);
+  r.density = std::exp(-0.5 * r.across * r.across / r.variance) / std::sqrt(2.0 * M_PI * r.variance);
+  return r;
+}
+
 struct SurfaceFit {
   double on_surface = 0.0;      // fraction within 3 sigma
   double log_likelihood = 0.0;  // mean log of (Gaussian + outlier) / outlier, the outlier uniform over +-reach
@@ -484,18 +510,10 @@ SurfaceFit FitOnSurface(const PointCloud& from, const TargetLevel& to, const Loc
   double log_likelihood = 0.0;
   for (std::size_t j = 0; j < from.size(); j += stride) {
     ++tried;
-    const Eigen::Vector3d y = T * from.points[j];
-    std::uint32_t index;
-    double d2;
-    if (to.tree->knnSearch(y.data(), 1, &index, &d2) != 1 || d2 > reach * reach) continue;
-    const Eigen::Vector3d& normal = to_surface.normals[index];
-    if (normal.isZero()) continue;
-    const Eigen::Vector3d moved_normal = T.linear().transpose() * normal;
-    const double variance = to_surface.normal_variances[index] + moved_normal.dot(from.covariances[j] * moved_normal);
-    const double across = normal.dot(y - to.cloud.points[index]);
-    on += across * across <= 9.0 * variance ? 1 : 0;
-    const double density = std::exp(-0.5 * across * across / variance) / std::sqrt(2.0 * M_PI * variance);
-    log_likelihood += std::log((density + outlier) / outlier);
+    const auto r = ResidualOnSurface(from.points[j], from.covariances[j], to, to_surface, T, reach);
+    if (!r) continue;
+    on += r->across * r->across <= 9.0 * r->variance ? 1 : 0;
+    log_likelihood += std::log((r->density + outlier) / outlier);
   }
   SurfaceFit fit;
   if (tried > 0) fit = {static_cast<double>(on) / tried, log_likelihood / tried};
@@ -530,22 +548,14 @@ Eigen::Isometry3d PolishOnSurface(const Prepared& p, const RegistrationOptions& 
     Matrix6 H = Matrix6::Zero();
     Vector6 g = Vector6::Zero();
     for (std::size_t j = 0; j < from.size(); j += stride) {
-      const Eigen::Vector3d y = T * from.points[j];
-      std::uint32_t index;
-      double d2;
-      if (p.levels[0].tree->knnSearch(y.data(), 1, &index, &d2) != 1 || d2 > reach * reach) continue;
-      const Eigen::Vector3d& normal = p.target_surface.normals[index];
-      if (normal.isZero()) continue;
-      const Eigen::Vector3d moved_normal = T.linear().transpose() * normal;
-      const double variance = p.target_surface.normal_variances[index] + moved_normal.dot(from.covariances[j] * moved_normal);
-      const double across = normal.dot(y - p.levels[0].cloud.points[index]);
-      const double density = std::exp(-0.5 * across * across / variance) / std::sqrt(2.0 * M_PI * variance);
-      const double weight = density / (density + outlier) / variance;
+      const auto r = ResidualOnSurface(from.points[j], from.covariances[j], p.levels[0], p.target_surface, T, reach);
+      if (!r) continue;
+      const double weight = r->density / (r->density + outlier) / r->variance;
       Vector6 J;  // d across / d (rotation vector, translation) of a left update
-      J.head<3>() = y.cross(normal);
-      J.tail<3>() = normal;
+      J.head<3>() = r->moved.cross(r->normal);
+      J.tail<3>() = r->normal;
       H += weight * J * J.transpose();
-      g += weight * J * across;
+      g += weight * J * r->across;
     }
     const Vector6 delta = -(H + 1e-9 * Matrix6::Identity()).ldlt().solve(g);
     if (!delta.allFinite()) break;
