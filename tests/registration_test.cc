@@ -168,14 +168,22 @@ TEST(Dugma, BothWaysCheckTrustsAGoodResult) {
   EXPECT_GT(good.consistency_deg, 0.0);  // it ran
 }
 
+namespace {
+
+// The first `count` pairs of the rendered set (test lawn, seed 1), rendered in a folder of their own.
+std::vector<scenarios::RegistrationPair> RenderedPairs(int count, const std::string& folder) {
+  scenarios::RegistrationSetOptions options;
+  options.pairs = count;
+  return scenarios::RenderRegistrationPairs(options, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR}, testing::TempDir(folder));
+}
+
+}  // namespace
+
 // The rendered data set's truth and back-projection agree: the second view moved by the truth lies
 // on the first (median distance to the nearest point of X, over the points that have one within
 // 0.2 m, about the Kinect-like noise and the point spacing), and far from it without the truth.
 TEST(RegistrationSet, RenderedPairsLieOnEachOtherUnderTheirTruth) {
-  scenarios::RegistrationSetOptions options;
-  options.pairs = 2;
-  const auto pairs = scenarios::RenderRegistrationPairs(options, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR},
-                                                        testing::TempDir("registration_set"));
+  const auto pairs = RenderedPairs(2, "registration_set");
   ASSERT_EQ(pairs.size(), 2u);
   for (const auto& pair : pairs) {
     EXPECT_GT(pair.x.size(), 1000u);
@@ -206,10 +214,7 @@ namespace {
 // starts about the ground's normal have to find the turn, and the surface likelihood has to pick
 // it. The first six pairs of the seed-1 set: a single start gets 3 of them under 5 deg.
 TEST(Dugma, HeadingStartsFindTheTurnAboutARoundBush) {
-  scenarios::RegistrationSetOptions set;
-  set.pairs = 6;
-  const auto pairs = scenarios::RenderRegistrationPairs(set, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR},
-                                                        testing::TempDir("registration_heading"));
+  const auto pairs = RenderedPairs(6, "registration_heading");
   ASSERT_EQ(pairs.size(), 6u);
   RegistrationOptions options;
   options.heading_search_deg = 45.0;

@@ -98,8 +98,10 @@ struct SourceTerms {
   int pairs = 0;
 };
 
-// argmin over R, t of sum_j w_j |xbar_j - R y_j - t|^2 with xbar_j = weighted_target_j / w_j.
-Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const std::vector<Eigen::Vector3d>& y) {
+// argmin over R, t of sum_j w_j |xbar_j - R y_j - t|^2 with xbar_j = weighted_target_j / w_j; with
+// `fixed_rotation` only t moves.
+Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const std::vector<Eigen::Vector3d>& y,
+                                 const Eigen::Matrix3d* fixed_rotation = nullptr) {
   double total = 0.0;
   Eigen::Vector3d sum_x = Eigen::Vector3d::Zero(), sum_y = Eigen::Vector3d::Zero();
   for (std::size_t j = 0; j < y.size(); ++j) {
@@ -110,6 +112,11 @@ Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const st
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (total <= 0.0) return T;
   const Eigen::Vector3d mean_x = sum_x / total, mean_y = sum_y / total;
+  if (fixed_rotation != nullptr) {
+    T.linear() = *fixed_rotation;
+    T.translation() = mean_x - T.linear() * mean_y;
+    return T;
+  }
   Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();  // sum w (y - mean_y)(x - mean_x)^T
   for (std::size_t j = 0; j < y.size(); ++j) {
     if (terms[j].weight <= 0.0) continue;
@@ -199,7 +206,7 @@ struct Prepared {
   std::deque<TargetLevel> levels;       // a deque: growing it never moves a level its tree points into
   std::vector<PointCloud> source_levels;
   // The full source with its own tree, and both clouds' local surfaces with the sensor's variance
-  // across them (before any surface patch): what OverlapScore judges a result by.
+  // across them (before any surface patch): what FitBothWays judges a result by.
   TargetLevel source_full;
   LocalSurface target_surface, source_surface;
 };
@@ -272,10 +279,14 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
 }
 
 // The RMS distance of the points from their centroid: the cloud's size.
+Eigen::Vector3d Centroid(const PointCloud& cloud) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& point : cloud.points) sum += point;
+  return sum / static_cast<double>(std::max<std::size_t>(1, cloud.size()));
+}
+
 double RmsRadius(const PointCloud& cloud) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& point : cloud.points) centroid += point;
-  centroid /= static_cast<double>(cloud.size());
+  const Eigen::Vector3d centroid = Centroid(cloud);
   double spread2 = 0.0;
   for (const auto& point : cloud.points) spread2 += (point - centroid).squaredNorm();
   return std::sqrt(spread2 / static_cast<double>(cloud.size()));
@@ -384,15 +395,8 @@ Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud&
                         bool closed_form, int pairs, bool translation_only) {
   Eigen::Isometry3d next = T;
   if (closed_form && translation_only) {
-    double total = 0.0;
-    Eigen::Vector3d sum_x = Eigen::Vector3d::Zero(), sum_y = Eigen::Vector3d::Zero();
-    for (std::size_t j = 0; j < terms.size(); ++j) {
-      total += terms[j].weight;
-      sum_x += terms[j].weighted_target;
-      sum_y += terms[j].weight * moving.points[j];
-    }
-    if (total > 0.0) next.translation() = (sum_x - T.linear() * sum_y) / total;
-    return next;
+    const Eigen::Matrix3d rotation = T.linear();
+    return WeightedKabsch(terms, moving.points, &rotation);
   }
   if (closed_form) return WeightedKabsch(terms, moving.points);
   Matrix6 H = Matrix6::Zero();
@@ -599,12 +603,6 @@ Eigen::Vector3d DominantNormal(const LocalSurface& surface, double min_support) 
   }
   const double sampled = static_cast<double>((n + sample - 1) / sample);
   return static_cast<double>(best_support) >= min_support * sampled ? best : Eigen::Vector3d::Zero();
-}
-
-Eigen::Vector3d Centroid(const PointCloud& cloud) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const auto& point : cloud.points) sum += point;
-  return sum / static_cast<double>(std::max<std::size_t>(1, cloud.size()));
 }
 
 // One DUGMA run from T (EM, then the polish), judged by its fit on the surfaces.
