@@ -15,6 +15,7 @@ PACKAGES=(
   libompl-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
   clang libclang-rt-dev
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()
@@ -31,11 +32,12 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# BUILD_DIR (default build/) and TRIMBOT_SANITIZE=ON (AddressSanitizer + UndefinedBehaviorSanitizer,
-# what scripts/run_tests.sh builds in build-asan/) choose the build.
+# BUILD_DIR (default build/), BUILD_TYPE (default Release: -O2, no debug information; RelWithDebInfo
+# for a debugger), TRIMBOT_SANITIZE=ON (AddressSanitizer + UndefinedBehaviorSanitizer, what
+# scripts/run_tests.sh builds in build-asan/) and BUILD_TARGET (default: everything) choose the build.
 BUILD_DIR="${BUILD_DIR:-build}"
 if [ ! -f "$BUILD_DIR/build.ninja" ]; then
-  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIMBOT_SANITIZE="${TRIMBOT_SANITIZE:-OFF}"
+  cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DTRIMBOT_SANITIZE="${TRIMBOT_SANITIZE:-OFF}"
 fi
 # Two cores: two compile jobs keep memory and time in check.
-cmake --build "$BUILD_DIR" -j "${BUILD_JOBS:-2}"
+cmake --build "$BUILD_DIR" -j "${BUILD_JOBS:-2}" ${BUILD_TARGET:+--target "$BUILD_TARGET"}

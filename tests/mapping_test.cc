@@ -98,10 +98,10 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
 // run them in any order, in parallel).
 scenarios::MapBuildOptions ShortLawnMap(const std::string& dir) {
   scenarios::MapBuildOptions options;
-  options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.recipe.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
   options.out_dir = dir;
   options.paths = {TRIMBOT_SOURCE_DIR};
-  options.seconds = 7.0;
+  options.recipe.seconds = 7.0;
   return options;
 }
 

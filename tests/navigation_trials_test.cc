@@ -30,13 +30,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 json ReadJson(const std::string& path) {
   std::ifstream in(path);
   return json::parse(in);
@@ -44,7 +37,7 @@ json ReadJson(const std::string& path) {
 
 // The smoke scenario with `replace` -> `with` applied to its text, written to a temp file.
 std::string SmokeVariant(const std::string& name, const std::string& replace, const std::string& with) {
-  std::string text = ReadText(testing::SourcePath("scenarios/navigation/smoke.yaml"));
+  std::string text = testing::ReadText(testing::SourcePath("scenarios/navigation/smoke.yaml"));
   if (!replace.empty()) text = std::regex_replace(text, std::regex(replace), with);
   return testing::WriteTempFile(name, text);
 }
@@ -305,7 +298,7 @@ TEST(Batch, ShardsMergeIntoTheWholeBatchAndTrialsReplayBySeed) {
   }
   EXPECT_EQ(summary["metrics"]["success_rate"], 1.0);
   EXPECT_TRUE(summary["pass"].get<bool>());
-  EXPECT_NE(ReadText(root + "/merged/junit.xml").find("tests=\""), std::string::npos);
+  EXPECT_NE(testing::ReadText(root + "/merged/junit.xml").find("tests=\""), std::string::npos);
   EXPECT_TRUE(fs::exists(root + "/merged/trajectories.png"));
   EXPECT_TRUE(fs::exists(root + "/merged/localization_errors.png"));
 
@@ -317,10 +310,10 @@ TEST(Batch, ShardsMergeIntoTheWholeBatchAndTrialsReplayBySeed) {
   replay.seed = 41;
   replay.out_dir = root + "/replay";
   EXPECT_EQ(RunBatch(replay), 0);
-  const std::string original = ReadText(root + "/merged/trials/001/ground_truth.tum");
+  const std::string original = testing::ReadText(root + "/merged/trials/001/ground_truth.tum");
   EXPECT_FALSE(original.empty());
-  EXPECT_EQ(ReadText(root + "/replay/trials/000/ground_truth.tum"), original);
-  EXPECT_NE(ReadText(root + "/merged/trials/000/ground_truth.tum"), original) << "another seed, another run";
+  EXPECT_EQ(testing::ReadText(root + "/replay/trials/000/ground_truth.tum"), original);
+  EXPECT_NE(testing::ReadText(root + "/merged/trials/000/ground_truth.tum"), original) << "another seed, another run";
 }
 
 TEST(Batch, ATrialThatTimesOutIsRecordedWithItsSeedAndTheBatchGoesOn) {
@@ -340,7 +333,7 @@ TEST(Batch, ATrialThatTimesOutIsRecordedWithItsSeedAndTheBatchGoesOn) {
     EXPECT_FALSE(summary["trials"][i]["success"].get<bool>());
   }
   EXPECT_FALSE(summary["pass"].get<bool>());
-  const std::string junit = ReadText(out + "/junit.xml");
+  const std::string junit = testing::ReadText(out + "/junit.xml");
   EXPECT_NE(junit.find("<failure"), std::string::npos);
 }
 

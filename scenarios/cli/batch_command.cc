@@ -2,7 +2,9 @@
 
 #include <memory>
 
-#include "runner/batch.h"
+#include "cli/cluster_options.h"
+#include "runner/batch_executor.h"
+#include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
 
@@ -19,17 +21,20 @@ void AddBatchCommands(CLI::App& app, const std::string& data_root, int& exit_cod
                             ->check(CLI::Range(1, 100000));
   auto* seed_option = run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
   run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
-  run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
+  auto* shard_option = run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
   run->add_option("--set", options->overrides,
                   "override a scenario or stack parameter, key.path=value (repeatable), e.g. "
                   "--set stack.navigation.follower.cruise_speed=0.3 --set trials=3");
-  run->callback([options, trials, seed, shard, trials_option, seed_option, &data_root, &exit_code]() {
+  auto cluster = AddClusterOptions(run);
+  run->callback([options, trials, seed, shard, trials_option, seed_option, shard_option, cluster, &data_root, &exit_code]() {
     options->paths = {data_root};
     if (trials_option->count() > 0) options->trials = *trials;
     if (seed_option->count() > 0) options->seed = *seed;
     std::tie(options->shard_index, options->shard_count) = ParseShard(*shard, "--shard");
-    exit_code = RunBatch(*options);
+    if (cluster->slurm && shard_option->count() > 0) throw InputError("--shard", "--slurm makes the shards itself");
+    const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
+    exit_code = RunBatches(executor.get(), {*options}).front();
   });
 
   auto shard_dirs = std::make_shared<std::vector<std::string>>();

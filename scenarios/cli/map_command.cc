@@ -1,9 +1,12 @@
 #include "cli/map_command.h"
 
+#include <iostream>
 #include <memory>
 
 #include "runner/localization_eval.h"
+#include "runner/map_cache.h"
 #include "runner/mapping.h"
+#include "runner/scenario.h"
 #include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
@@ -63,27 +66,41 @@ void AddMapCommands(CLI::App& app, const std::string& data_root, int& exit_code)
   auto seed = std::make_shared<std::uint64_t>(0);
   auto seconds = std::make_shared<double>(0.0);
   auto* build = map->add_subcommand("build", "render a mapping drive and build a map (Upright-SIFT, Ceres bundle adjustment)");
-  build->add_option("plan", options->plan_path, "drive plan (YAML) of the mapping drive")->required();
+  build->add_option("plan", options->recipe.plan_path, "drive plan (YAML) of the mapping drive")->required();
   build->add_option("--out", options->out_dir, "output folder (map.sqlite, map_stats.json, map_top_view.png)")->required();
   auto* seed_option = build->add_option("--seed", *seed, "seed of the drive and of the survey noise (default: the plan's)");
   auto* seconds_option = build->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
                              ->check(CLI::Range(1e-3, 1e6));
-  build->add_option("--survey-position-sigma", options->survey_position_sigma, "survey noise per axis (m)")
+  build->add_option("--survey-position-sigma", options->recipe.survey_position_sigma, "survey noise per axis (m)")
       ->check(CLI::Range(0.0, 1.0));
-  build->add_option("--survey-rotation-sigma-deg", options->survey_rotation_sigma_deg, "survey rotation noise (deg)")
+  build->add_option("--survey-rotation-sigma-deg", options->recipe.survey_rotation_sigma_deg, "survey rotation noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
   auto descriptor = std::make_shared<std::string>();
   build->add_option("--descriptor", *descriptor, "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)");
   build->callback([options, seed, seconds, seed_option, seconds_option, descriptor, &data_root, &exit_code]() {
     try {
-      if (!descriptor->empty()) options->descriptor = visual_localization::DescriptorFromString(*descriptor);
+      if (!descriptor->empty()) options->recipe.descriptor = visual_localization::DescriptorFromString(*descriptor);
     } catch (const std::invalid_argument& e) {
       throw InputError("--descriptor", e.what());
     }
     options->paths = {data_root};
-    if (seed_option->count() > 0) options->seed = *seed;
-    if (seconds_option->count() > 0) options->seconds = *seconds;
+    if (seed_option->count() > 0) options->recipe.seed = *seed;
+    if (seconds_option->count() > 0) options->recipe.seconds = *seconds;
     exit_code = RunMapBuild(*options);
+  });
+  auto scenario_path = std::make_shared<std::string>();
+  auto overrides = std::make_shared<std::vector<std::string>>();
+  auto* ensure = map->add_subcommand(
+      "ensure", "build a scenario's map (visual_map: {mapping_drive: ...}) into the map cache unless it is there");
+  ensure->add_option("scenario", *scenario_path, "scenario file (YAML)")->required();
+  ensure->add_option("--set", *overrides, "override a scenario key, key.path=value (repeatable)");
+  ensure->callback([scenario_path, overrides, &data_root, &exit_code]() {
+    Scenario scenario = Scenario::Load(*scenario_path, ParseOverrides(*overrides));
+    const auto map = ResolveVisualMap(scenario, ProjectPaths{data_root});
+    if (!map) throw InputError(*scenario_path, "key 'visual_map': the scenario builds no map (it names a map file, or "
+                                               "does not localize visually)");
+    std::cout << "[map] " << (map->built ? "built" : "cached") << ": " << map->path << std::endl;
+    exit_code = 0;
   });
   AddEvalCommand(map, "bench", "localize ring frames of a query drive: fixes, errors, time per stage (median) and its histogram",
                  data_root, exit_code, RunLocalizationBench);

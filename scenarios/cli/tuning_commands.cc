@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "cli/cluster_options.h"
 #include "runner/sweep.h"
 #include "runner/tune.h"
 
@@ -21,10 +22,13 @@ void AddSweep(CLI::App& app, const std::string& data_root, int& exit_code) {
   auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
   sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
   sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
-  sweep->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
+  auto cluster = AddClusterOptions(sweep);
+  sweep->callback([options, trials, seed, trials_option, seed_option, cluster, &data_root, &exit_code]() {
     options->paths = {data_root};
     if (trials_option->count() > 0) options->trials = *trials;
     if (seed_option->count() > 0) options->seed = *seed;
+    const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
+    options->executor = executor.get();
     exit_code = RunSweep(*options);
   });
 }
@@ -48,10 +52,13 @@ void AddTune(CLI::App& app, const std::string& data_root, int& exit_code) {
   tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
   tune->add_option("--out", options->out_dir, "output folder")->required();
   tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
-  tune->callback([options, trials, seed, trials_option, seed_option, &data_root, &exit_code]() {
+  auto cluster = AddClusterOptions(tune);
+  tune->callback([options, trials, seed, trials_option, seed_option, cluster, &data_root, &exit_code]() {
     options->paths = {data_root};
     if (trials_option->count() > 0) options->trials = *trials;
     if (seed_option->count() > 0) options->seed = *seed;
+    const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
+    options->executor = executor.get();
     exit_code = RunTune(*options);
   });
 }

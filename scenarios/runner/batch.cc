@@ -25,6 +25,7 @@
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
+#include "runner/map_cache.h"
 #include "runner/prior_knowledge.h"
 #include "runner/scenario.h"
 #include "runner/trial.h"
@@ -373,13 +374,21 @@ void PrintProgress(const std::vector<RunningTrial>& running, std::size_t done, i
 
 }  // namespace
 
+Scenario LoadBatchScenario(const BatchOptions& options) {
+  Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
+  StackParametersFor(scenario, options.paths);
+  PriorMap(scenario, options.paths);
+  MissionGoals(scenario, options.paths);
+  CheckArmReach(scenario, options.paths);
+  GoalTruths(scenario, options.paths);
+  return scenario;
+}
+
 int RunBatch(const BatchOptions& options) {
   // Every input is read and checked before the output folder is touched.
-  const Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
-  StackParametersFor(scenario, options.paths);
+  Scenario scenario = LoadBatchScenario(options);
   const garden::OccupancyMap map = PriorMap(scenario, options.paths);
   const std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
-  CheckArmReach(scenario, options.paths);
   const std::vector<GoalTruth> true_goals = GoalTruths(scenario, options.paths);
   const std::string& out = options.out_dir;
   BatchInfo info;
@@ -391,6 +400,11 @@ int RunBatch(const BatchOptions& options) {
   info.overrides = scenario.overrides;
   if (info.trials < 1) throw InputError(options.scenario_path, "--trials must be at least 1");
   if (options.jobs < 1) throw InputError(options.scenario_path, "--jobs must be at least 1");
+  // A map the scenario builds from a mapping drive: from the cache, built there on first use.
+  if (const auto map = ResolveVisualMap(scenario, options.paths); map && !options.quiet) {
+    std::cout << "[map] " << (map->built ? "built" : "cached") << ": " << map->path
+              << (map->built ? " in " + std::to_string(static_cast<int>(map->build_seconds)) + " s" : "") << std::endl;
+  }
 
   fs::create_directories(out);
   WriteFileAtomically(out + "/batch.json", ToJson(info).dump(2));
@@ -455,7 +469,8 @@ void ReplaceFolder(const std::string& staged, const std::string& target) {
   fs::remove_all(replaced);
 }
 
-int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths) {
+int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, const ProjectPaths& paths,
+                bool quiet) {
   if (shard_dirs.empty()) throw InputError(out_dir, "merge needs at least one shard folder");
   // Every shard is read and checked before anything is written: a missing, broken or foreign shard
   // leaves out_dir as it was. The merge is built beside out_dir and swapped in at the end.
@@ -509,8 +524,10 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
               << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(staging + "/scenario.yaml");
+  std::ostream null_log(nullptr);  // writes nothing
   const int exit_code = WriteReports(staging, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
-                                     GoalPositions(MissionGoals(scenario, paths)), merged, found, merged.trials, std::cout);
+                                     GoalPositions(MissionGoals(scenario, paths)), merged, found, merged.trials,
+                                     quiet ? null_log : std::cout);
   ReplaceFolder(staging, out_dir);
   return exit_code;
 }

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "runner/scenario.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -48,7 +49,11 @@ int RunBatch(const BatchOptions& options);
 // Merges the output folders of shards of one batch into `out_dir` and writes the reports of the
 // whole batch. Returns the exit code as RunBatch.
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir,
-                const ProjectPaths& paths = ProjectPaths::Default());
+                const ProjectPaths& paths = ProjectPaths::Default(), bool quiet = false);
+
+// The batch's scenario with its overrides, checked as RunBatch checks it before it writes anything
+// (stack parameters, prior map, goals, arm_reach). Throws InputError naming the file and key.
+Scenario LoadBatchScenario(const BatchOptions& options);
 
 // "i/n" -> (i, n), 0 <= i < n; throws InputError naming `what` on bad text.
 std::pair<int, int> ParseShard(const std::string& text, const std::string& what);

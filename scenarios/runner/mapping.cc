@@ -104,19 +104,19 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   auto drive = std::make_unique<MappingDrive>();
   stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
   drive->descriptor = parameters.visual.descriptor;
-  if (!YamlMap::LoadFile(options.plan_path).Has("goals")) {
-    drive->plan = DrivePlan::Load(options.plan_path);
+  if (!YamlMap::LoadFile(options.recipe.plan_path).Has("goals")) {
+    drive->plan = DrivePlan::Load(options.recipe.plan_path);
     drive->world = drive->plan->world;
-    if (options.seed) drive->world.seed = *options.seed;
-    drive->duration = std::min(drive->plan->duration(), options.seconds.value_or(drive->plan->duration()));
+    if (options.recipe.seed) drive->world.seed = *options.recipe.seed;
+    drive->duration = std::min(drive->plan->duration(), options.recipe.seconds.value_or(drive->plan->duration()));
     drive->controller = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
     return drive;
   }
-  drive->scenario = Scenario::Load(options.plan_path);
+  drive->scenario = Scenario::Load(options.recipe.plan_path);
   const Scenario& scenario = *drive->scenario;
   drive->world = scenario.world;
-  drive->world.seed = options.seed.value_or(scenario.world.seed + kMappingSeedOffset);
-  drive->duration = std::min(scenario.time_limit, options.seconds.value_or(scenario.time_limit));
+  drive->world.seed = options.recipe.seed.value_or(scenario.world.seed + kMappingSeedOffset);
+  drive->duration = std::min(scenario.time_limit, options.recipe.seconds.value_or(scenario.time_limit));
   if (scenario.stack) parameters = parameters.Overridden(*scenario.stack);
   drive->descriptor = parameters.visual.descriptor;
   if (parameters.localization == stack::LocalizationSource::kVisual) {
@@ -135,6 +135,15 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
 
 }  // namespace
 
+visual_localization::MapBuilderOptions MapBuilderOptionsFor(const MapRecipe& recipe,
+                                                            visual_localization::Descriptor descriptor) {
+  visual_localization::MapBuilderOptions options;
+  options.survey_position_sigma = recipe.survey_position_sigma;
+  options.survey_rotation_sigma = recipe.survey_rotation_sigma_deg * M_PI / 180.0;
+  options.features.descriptor = descriptor;
+  return options;
+}
+
 int RunMapBuild(const MapBuildOptions& options) {
   const auto wall_start = Clock::now();
   std::filesystem::create_directories(options.out_dir);
@@ -146,10 +155,8 @@ int RunMapBuild(const MapBuildOptions& options) {
 
   // The map is made with the calibration the robot's stack reads (robot/), as the real one was.
   const robot::CameraRig rig = robot::LoadCameraRig(options.paths.robot_files());
-  visual_localization::MapBuilderOptions builder_options;
-  builder_options.survey_position_sigma = options.survey_position_sigma;
-  builder_options.survey_rotation_sigma = options.survey_rotation_sigma_deg * M_PI / 180.0;
-  builder_options.features.descriptor = options.descriptor.value_or(drive->descriptor);
+  const visual_localization::MapBuilderOptions builder_options =
+      MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(drive->descriptor));
   visual_localization::MapBuilder builder(rig, builder_options);
   SurveyPoses survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
 
@@ -159,15 +166,25 @@ int RunMapBuild(const MapBuildOptions& options) {
   loop.render_on_demand = true;
   loop.ring_demand = [&](const sim::GroundTruth& truth) { return builder.WantsFrame(survey.PoseAt(truth)); };
   loop.pose_fixes = drive->fixes ? &*drive->fixes : nullptr;
-  std::cout << "[map] driving " << options.plan_path << " (up to " << drive->duration << " s), rendering keyframes"
+  // Progress every 10 simulated seconds: a mapping drive renders for minutes.
+  loop.progress = [&](double t) {
+    if (static_cast<int>(t) % 10 != 0) return;
+    std::cout << "[map] " << static_cast<int>(t) << "/" << static_cast<int>(drive->duration) << " s driven, "
+              << builder.keyframes() << " keyframes, "
+              << static_cast<int>(std::chrono::duration<double>(Clock::now() - wall_start).count()) << " s elapsed"
+              << std::endl;
+  };
+  std::cout << "[map] driving " << options.recipe.plan_path << " (up to " << drive->duration << " s), rendering keyframes"
             << std::endl;
   RunClosedLoop(simulator, *drive->controller, {&recorder}, loop);
   const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
+  std::cout << "[map] drive done, " << builder.keyframes() << " keyframes in " << static_cast<int>(drive_seconds)
+            << " s; features, matching, bundle adjustment..." << std::endl;
   visual_localization::MapBuildStats stats;
   const visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
   if (map.points.empty()) {
-    throw std::runtime_error(options.plan_path + ": the mapping drive gave no map points (" + std::to_string(stats.keyframes) +
+    throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" + std::to_string(stats.keyframes) +
                              " keyframes; too short, or nothing textured in view)");
   }
   map.Save(options.out_dir + "/map.sqlite");
@@ -176,7 +193,7 @@ int RunMapBuild(const MapBuildOptions& options) {
                   "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
                       std::to_string(stats.keyframes) + " keyframes");
   const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  nlohmann::json report = {{"plan", options.plan_path}, {"garden", map.garden}, {"seed", world.seed},
+  nlohmann::json report = {{"plan", options.recipe.plan_path}, {"garden", map.garden}, {"seed", world.seed},
                            {"descriptor", visual_localization::ToString(map.descriptor)},
                            {"frames_seen", stats.frames}, {"keyframes", stats.keyframes},
                            {"images_matched", stats.images_matched}, {"matches", stats.matches},

@@ -12,23 +12,24 @@
 #include <optional>
 #include <string>
 
+#include "runner/map_recipe.h"
 #include "runner/world_setup.h"
 #include "trimbot/visual_localization/features.h"
+#include "trimbot/visual_localization/map_builder.h"
 
 namespace trimbot::scenarios {
 
 struct MapBuildOptions {
-  std::string plan_path;
+  MapRecipe recipe;
   std::string out_dir;
   ProjectPaths paths;
-  std::optional<std::uint64_t> seed;     // the drive's (and the survey noise's) seed
-  std::optional<double> seconds;         // stop the drive early
-  double survey_position_sigma = 0.02;   // m per axis
-  double survey_rotation_sigma_deg = 0.5;
-  // Upright-SIFT or SIFT; default: the stack's (stack.yaml, with the scenario's stack section).
-  std::optional<visual_localization::Descriptor> descriptor;
 };
 
 int RunMapBuild(const MapBuildOptions& options);
+
+// The map builder's settings for a recipe whose descriptor is `descriptor`: what RunMapBuild uses,
+// and what a cached map's key records.
+visual_localization::MapBuilderOptions MapBuilderOptionsFor(const MapRecipe& recipe,
+                                                            visual_localization::Descriptor descriptor);
 
 }  // namespace trimbot::scenarios

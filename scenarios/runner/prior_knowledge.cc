@@ -182,9 +182,10 @@ stack::StackParameters StackParametersFor(const Scenario& scenario, const Projec
                                           stack::ToString(parameters.localization) +
                                           "' (set stack: {localization: simulated_pose_fixes} to use them)");
   }
-  if (parameters.localization == stack::LocalizationSource::kVisual && scenario.visual_map.empty()) {
+  if (parameters.localization == stack::LocalizationSource::kVisual && scenario.visual_map.empty() &&
+      !scenario.visual_map_recipe) {
     throw InputError(scenario.source, "the stack's localization is 'visual', but the scenario names no visual_map "
-                                      "(build one with `trimbot map build`)");
+                                      "(a map file, or {mapping_drive: PLAN} to build one on first use)");
   }
   return parameters;
 }

@@ -88,6 +88,28 @@ CalibrationError ReadCalibrationError(const YamlMap& map) {
   return e;
 }
 
+// `visual_map: PATH` (a built map file) or `visual_map: {mapping_drive: PLAN, ...}` (a map built on
+// first use from that drive and cached: runner/map_cache.h). Paths are relative to the scenario.
+void ReadVisualMap(const YamlMap& root, Scenario& s) {
+  const auto relative_to_scenario = [&](const std::filesystem::path& path) {
+    return (path.is_absolute() ? path : std::filesystem::path(s.source).parent_path() / path).string();
+  };
+  if (!root.node()["visual_map"].IsMap()) {
+    s.visual_map = relative_to_scenario(root.String("visual_map"));
+    return;
+  }
+  const YamlMap spec = root.Map("visual_map");
+  MapRecipe recipe;
+  recipe.plan_path = relative_to_scenario(spec.String("mapping_drive"));
+  if (spec.Has("seed")) recipe.seed = static_cast<std::uint64_t>(spec.Integer("seed", 0, 2147483647));
+  if (spec.Has("seconds")) recipe.seconds = spec.Number("seconds", 1e-3, 1e6, "s");
+  recipe.survey_position_sigma = spec.NumberOr("survey_position_sigma", recipe.survey_position_sigma, 0.0, 1.0, "m");
+  recipe.survey_rotation_sigma_deg =
+      spec.NumberOr("survey_rotation_sigma_deg", recipe.survey_rotation_sigma_deg, 0.0, 10.0, "deg");
+  spec.RejectUnknownKeys();
+  s.visual_map_recipe = recipe;
+}
+
 void ReadMission(const YamlMap& root, Scenario& s) {
   if (root.Has("map")) {
     const YamlMap map = root.Map("map");
@@ -141,10 +163,7 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     sigma.RejectUnknownKeys();
   }
   if (root.Has("calibration_error")) s.calibration_error = ReadCalibrationError(root.Map("calibration_error"));
-  if (root.Has("visual_map")) {
-    const std::filesystem::path map = root.String("visual_map");
-    s.visual_map = (map.is_absolute() ? map : std::filesystem::path(s.source).parent_path() / map).string();
-  }
+  if (root.Has("visual_map")) ReadVisualMap(root, s);
 }
 
 void ReadPlant(const YamlMap& root, Scenario& s) {

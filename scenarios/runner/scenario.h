@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "eval/simulated_pose_fixes.h"
+#include "runner/map_recipe.h"
 #include "runner/world_setup.h"
 #include "trimbot/common/overrides.h"
 #include "trimbot/common/yaml_reader.h"
@@ -90,6 +91,9 @@ struct Scenario {
   double initial_yaw_sigma = 3.0 * M_PI / 180.0;  // rad
   CalibrationError calibration_error;
   std::string visual_map;              // map file for localization: visual (relative to this file)
+  // Or the mapping drive the map is built from on first use (then cached; the batch sets
+  // visual_map to the cached file before any trial runs).
+  std::optional<MapRecipe> visual_map_recipe;
   int trials = 1;
   double time_limit = 300.0;           // s of simulated time per trial
   double wall_time_limit = 1800.0;     // s of wall-clock time per trial before it is killed

@@ -9,7 +9,7 @@
 
 #include "eval/comparison.h"
 #include "reports/sweep_plot.h"
-#include "runner/batch.h"
+#include "runner/batch_executor.h"
 #include "runner/prior_knowledge.h"
 #include "runner/scenario.h"
 #include "trimbot/common/atomic_file.h"
@@ -149,8 +149,8 @@ int RunSweep(const SweepOptions& options) {
     name = s.name;
   }
   fs::create_directories(options.out_dir);
-  json results = json::array();
   std::cout << "[sweep] " << name << ": " << points.size() << " points -> " << options.out_dir << std::endl;
+  std::vector<BatchOptions> batches;
   for (std::size_t i = 0; i < points.size(); ++i) {
     BatchOptions batch;
     batch.scenario_path = options.scenario_path;
@@ -161,15 +161,19 @@ int RunSweep(const SweepOptions& options) {
     batch.jobs = options.jobs;
     batch.overrides = PointOverrides(options, grids, points[i]);
     batch.quiet = true;
-    RunBatch(batch);
-    std::ifstream in(batch.out_dir + "/summary.json");
+    batches.push_back(batch);
+  }
+  std::vector<json> point_results(points.size());
+  RunBatches(options.executor, batches, [&](std::size_t i) {
+    std::ifstream in(batches[i].out_dir + "/summary.json");
     const auto estimates = BatchEstimates(json::parse(in));
-    results.push_back(PointJson(grids, points[i], i, estimates));
+    point_results[i] = PointJson(grids, points[i], i, estimates);
     std::cout << "[sweep] point " << i;
     for (std::size_t g = 0; g < grids.size(); ++g) std::cout << " " << grids[g].key << "=" << grids[g].values[points[i][g]];
     std::cout << std::setprecision(4) << ": success " << estimates[0].value << " [" << estimates[0].interval.low
               << ", " << estimates[0].interval.high << "], EKF error " << estimates[2].value << " m" << std::endl;
-  }
+  });
+  const json results = point_results;
   json grids_json;
   for (const auto& g : grids) grids_json[g.key] = g.values;
   const json sweep = {{"scenario", name}, {"scenario_file", options.scenario_path}, {"overrides", options.overrides},

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "runner/batch.h"
+#include "runner/batch_executor.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -32,6 +32,7 @@ struct SweepOptions {
   std::optional<int> trials;
   std::optional<std::uint64_t> seed;
   int jobs = DefaultJobs();
+  BatchExecutor* executor = nullptr;    // where the points run (null: here); all points at once
 };
 
 // Runs the sweep; returns 0 (a sweep reports, it does not judge). Bad input throws InputError.

@@ -87,7 +87,7 @@ class Search {
     batch.overrides = options_.overrides;
     batch.overrides.insert(batch.overrides.end(), point.begin(), point.end());
     batch.quiet = true;
-    RunBatch(batch);
+    RunBatches(options_.executor, {batch});
     std::ifstream in(dir + "/summary.json");
     const json summary = json::parse(in);
     if (summary_out != nullptr) *summary_out = summary;

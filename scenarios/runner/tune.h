@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "runner/batch.h"
+#include "runner/batch_executor.h"
 #include "runner/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -47,6 +47,7 @@ struct TuneOptions {
   std::string out_dir;
   ProjectPaths paths;
   std::vector<std::string> overrides;  // --set for every evaluation
+  BatchExecutor* executor = nullptr;   // where each evaluation's batch runs (null: here)
 };
 
 // Runs the search; returns 0 when the best point beats the scenario as it is on fresh seeds, 1

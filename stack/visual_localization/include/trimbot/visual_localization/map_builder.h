@@ -68,6 +68,7 @@ class MapBuilder {
   bool AddFrame(const messages::RingFrame& frame, const Eigen::Isometry3d& T_map_base_survey);
 
   VisualMap Build(const std::string& garden, MapBuildStats* stats);
+  int keyframes() const { return static_cast<int>(keyframes_.size()); }
 
  private:
   robot::CameraRig rig_;
