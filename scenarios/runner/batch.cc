@@ -185,9 +185,10 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   return timing;
 }
 
-// Summary, JUnit and plots of a set of trial results; returns the exit code.
+// Summary, JUnit and plots of a set of trial results, written into `out`; returns the exit code.
 // `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
-int WriteReports(const std::string& out, const Scenario& scenario, const garden::OccupancyMap& map,
+// `final_out`: the folder the log names (merge builds the reports beside it and swaps them in).
+int WriteReports(const std::string& out, const std::string& final_out, const Scenario& scenario, const garden::OccupancyMap& map,
                  const garden::OccupancyMap& world, const std::vector<Eigen::Vector2d>& goals, const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   BatchSummary summary;
@@ -244,7 +245,7 @@ int WriteReports(const std::string& out, const Scenario& scenario, const garden:
         << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>() << " ms over "
         << plans["plans"].get<int>() << " plans\n";
   }
-  log << "outputs in " << out << " (summary.json, junit.xml, timing.json, timing.png, "
+  log << "outputs in " << final_out << " (summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
                              : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");
   return summary.pass ? 0 : 1;
@@ -457,7 +458,7 @@ int RunBatch(const BatchOptions& options) {
     }
     if (interactive && !running.empty()) PrintProgress(running, results.size(), planned, scenario, batch_start);
   }
-  return WriteReports(out, scenario, map, WorldMap(scenario, options.paths), planned_goals, info, results, planned, log);
+  return WriteReports(out, out, scenario, map, WorldMap(scenario, options.paths), planned_goals, info, results, planned, log);
 }
 
 // `staged` becomes `target`: the folder it replaces is removed only once the new one is in place.
@@ -525,7 +526,7 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   }
   const Scenario scenario = Scenario::Load(staging + "/scenario.yaml");
   std::ostream null_log(nullptr);  // writes nothing
-  const int exit_code = WriteReports(staging, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
+  const int exit_code = WriteReports(staging, out_dir, scenario, PriorMap(scenario, paths), WorldMap(scenario, paths),
                                      GoalPositions(MissionGoals(scenario, paths)), merged, found, merged.trials,
                                      quiet ? null_log : std::cout);
   ReplaceFolder(staging, out_dir);
