@@ -375,22 +375,23 @@ void PrintProgress(const std::vector<RunningTrial>& running, std::size_t done, i
 
 }  // namespace
 
-Scenario LoadBatchScenario(const BatchOptions& options) {
+BatchInputs LoadBatchInputs(const BatchOptions& options) {
   Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
   StackParametersFor(scenario, options.paths);
-  PriorMap(scenario, options.paths);
-  MissionGoals(scenario, options.paths);
+  garden::OccupancyMap map = PriorMap(scenario, options.paths);
+  std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
   CheckArmReach(scenario, options.paths);
-  GoalTruths(scenario, options.paths);
-  return scenario;
+  std::vector<GoalTruth> true_goals = GoalTruths(scenario, options.paths);
+  return {std::move(scenario), std::move(map), std::move(planned_goals), std::move(true_goals)};
 }
 
 int RunBatch(const BatchOptions& options) {
   // Every input is read and checked before the output folder is touched.
-  Scenario scenario = LoadBatchScenario(options);
-  const garden::OccupancyMap map = PriorMap(scenario, options.paths);
-  const std::vector<Eigen::Vector2d> planned_goals = GoalPositions(MissionGoals(scenario, options.paths));
-  const std::vector<GoalTruth> true_goals = GoalTruths(scenario, options.paths);
+  BatchInputs inputs = LoadBatchInputs(options);
+  Scenario& scenario = inputs.scenario;
+  const garden::OccupancyMap& map = inputs.prior_map;
+  const std::vector<Eigen::Vector2d>& planned_goals = inputs.planned_goals;
+  const std::vector<GoalTruth>& true_goals = inputs.true_goals;
   const std::string& out = options.out_dir;
   BatchInfo info;
   info.scenario_file = fs::absolute(options.scenario_path).string();

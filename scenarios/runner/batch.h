@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "runner/prior_knowledge.h"
 #include "runner/scenario.h"
 #include "runner/world_setup.h"
 
@@ -51,9 +52,16 @@ int RunBatch(const BatchOptions& options);
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir,
                 const ProjectPaths& paths = ProjectPaths::Default(), bool quiet = false);
 
-// The batch's scenario with its overrides, checked as RunBatch checks it before it writes anything
-// (stack parameters, prior map, goals, arm_reach). Throws InputError naming the file and key.
-Scenario LoadBatchScenario(const BatchOptions& options);
+// What a batch is run from: its scenario with its overrides and what follows from it, read and
+// checked before anything is written (stack parameters, prior map, goals, arm_reach). Throws
+// InputError naming the file and key.
+struct BatchInputs {
+  Scenario scenario;
+  garden::OccupancyMap prior_map;
+  std::vector<Eigen::Vector2d> planned_goals;  // as planned (a bush goal: its surveyed centre), for plots
+  std::vector<GoalTruth> true_goals;           // where they truly are (a crashed trial lists them unreached)
+};
+BatchInputs LoadBatchInputs(const BatchOptions& options);
 
 // "i/n" -> (i, n), 0 <= i < n; throws InputError naming `what` on bad text.
 std::pair<int, int> ParseShard(const std::string& text, const std::string& what);

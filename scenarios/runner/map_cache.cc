@@ -20,6 +20,7 @@
 #include "runner/prior_knowledge.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/textures.h"
 #include "trimbot/visual_localization/visual_map.h"
@@ -28,15 +29,6 @@ namespace trimbot::scenarios {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::uint64_t Fnv1a(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (const unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 std::string Hex(std::uint64_t value) {
   std::ostringstream out;
@@ -216,13 +208,19 @@ CachedMap EnsureCachedMap(const MapRecipe& recipe, const ProjectPaths& paths, co
   return cached;
 }
 
-std::optional<CachedMap> ResolveVisualMap(Scenario& scenario, const ProjectPaths& paths, const std::string& cache_dir) {
+std::optional<MapRecipe> VisualMapRecipe(const Scenario& scenario, const ProjectPaths& paths) {
   if (!scenario.visual_map_recipe) return std::nullopt;
   const stack::StackParameters parameters = StackParametersFor(scenario, paths);
   if (parameters.localization != stack::LocalizationSource::kVisual) return std::nullopt;
   MapRecipe recipe = *scenario.visual_map_recipe;
   recipe.descriptor = parameters.visual.descriptor;  // the map is made for the localizer that reads it
-  CachedMap map = EnsureCachedMap(recipe, paths, cache_dir);
+  return recipe;
+}
+
+std::optional<CachedMap> ResolveVisualMap(Scenario& scenario, const ProjectPaths& paths, const std::string& cache_dir) {
+  const std::optional<MapRecipe> recipe = VisualMapRecipe(scenario, paths);
+  if (!recipe) return std::nullopt;
+  CachedMap map = EnsureCachedMap(*recipe, paths, cache_dir);
   scenario.visual_map = map.path;
   return map;
 }

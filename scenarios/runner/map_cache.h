@@ -46,6 +46,11 @@ CachedMap EnsureCachedMap(const MapRecipe& recipe, const ProjectPaths& paths, co
 // The cached map of `recipe` if the cache has it, else an empty path.
 std::string FindCachedMap(const MapRecipe& recipe, const ProjectPaths& paths, const std::string& cache_dir);
 
+// The recipe of the map a scenario builds on first use, with its stack's descriptor (the map is
+// made for the localizer that reads it); nullopt when it names a map file or does not localize
+// visually.
+std::optional<MapRecipe> VisualMapRecipe(const Scenario& scenario, const ProjectPaths& paths);
+
 // A scenario that localizes visually against a mapping drive (visual_map_recipe): its map from the
 // cache (built if missing), its visual_map set to the cached file. The recipe's descriptor is the
 // scenario's stack's. Nothing for any other scenario. Returns what EnsureCachedMap found or built.

@@ -19,7 +19,6 @@
 #include <nlohmann/json.hpp>
 
 #include "runner/map_cache.h"
-#include "runner/prior_knowledge.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 
@@ -110,15 +109,10 @@ std::string SubmitMissingMaps(const std::vector<BatchOptions>& batches, const st
   std::set<std::string> submitted;
   std::vector<std::string> jobs;
   for (std::size_t b = 0; b < batches.size(); ++b) {
-    const Scenario& s = scenarios[b];
-    if (!s.visual_map_recipe) continue;
-    const auto parameters = StackParametersFor(s, paths);
-    if (parameters.localization != stack::LocalizationSource::kVisual) continue;
-    MapRecipe recipe = *s.visual_map_recipe;
-    recipe.descriptor = parameters.visual.descriptor;
-    if (!FindCachedMap(recipe, paths, DefaultMapCacheDir()).empty()) continue;
+    const std::optional<MapRecipe> recipe = VisualMapRecipe(scenarios[b], paths);
+    if (!recipe || !FindCachedMap(*recipe, paths, DefaultMapCacheDir()).empty()) continue;
     CheckWritableFolder(DefaultMapCacheDir(), "TRIMBOT_MAP_CACHE");
-    const std::string id = MapCacheId(MapCacheKey(recipe, paths));
+    const std::string id = MapCacheId(MapCacheKey(*recipe, paths));
     if (!submitted.insert(id).second) continue;
     std::vector<std::string> ensure = {trimbot, "--data-root", paths.root, "map", "ensure",
                                        fs::absolute(batches[b].scenario_path).string()};
@@ -311,7 +305,7 @@ SlurmExecutor::SlurmExecutor(SlurmOptions options, ProjectPaths paths, const std
 std::vector<int> SlurmExecutor::Run(const std::vector<BatchOptions>& batches, const BatchDone& done) {
   // Every batch's scenario is checked here before anything is submitted.
   std::vector<Scenario> scenarios;
-  for (const auto& batch : batches) scenarios.push_back(LoadBatchScenario(batch));
+  for (const auto& batch : batches) scenarios.push_back(LoadBatchInputs(batch).scenario);
   const std::string work = options_.work_dir + "/submission_" + Index(submissions_++);
   fs::remove_all(work);
   for (const char* sub : {"logs", "status", "batches"}) fs::create_directories(work + "/" + sub);

@@ -17,10 +17,15 @@ inline std::uint64_t SplitMix64(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// 64-bit FNV-1a of a text: stream names here, cache keys elsewhere (scenarios/runner/map_cache.cc).
+inline std::uint64_t Fnv1a(std::string_view text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (char c : text) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+  return h;
+}
+
 inline std::uint64_t StreamSeed(std::uint64_t seed, std::string_view stream) {
-  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a of the stream name
-  for (char c : stream) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
-  return SplitMix64(seed ^ SplitMix64(h));
+  return SplitMix64(seed ^ SplitMix64(Fnv1a(stream)));
 }
 
 using Rng = std::mt19937_64;
