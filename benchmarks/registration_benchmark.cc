@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <map>
 
-#include "cli/registration_command.h"
-#include "eval/pose_errors.h"
+#include "evaluation/registration_pair_file.h"
+#include "evaluation/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "trimbot/perception/registration.h"
 

@@ -7,7 +7,7 @@
 #   SCENARIO=scenarios/navigation/hourglass_visual.yaml scripts/run_main.sh   another scenario
 #   SCENARIO=scenarios/navigation/rectangle.yaml scripts/run_main.sh          the fast one: pose fixes
 #                                                  drawn from ground truth (a test fixture, not localization)
-#   PLAN=scenarios/drives/wageningen_tour.yaml scripts/run_main.sh            an open-loop drive that
+#   PLAN=scenarios/drive_plans/wageningen_tour.yaml scripts/run_main.sh            an open-loop drive that
 #                                                                             records the camera ring
 # OUT_DIR sets the output folder; further arguments go to trimbot. Exit code 1: a criterion failed.
 set -euo pipefail

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "runner/drive_plan.h"
-#include "runner/prior_knowledge.h"
-#include "runner/scenario.h"
+#include "loop/drive_plan.h"
+#include "loop/prior_knowledge.h"
+#include "loop/scenario.h"
 #include "bad_input_corpus.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/garden.h"
@@ -93,7 +93,7 @@ TEST(BadInput, StackParametersAreCheckedAndNamed) {
 }
 
 TEST(BadInput, DrivePlanAndMapAreCheckedAndNamed) {
-  const std::string plan = ReadFile(testing::SourcePath("scenarios/drives/lawn_loop.yaml"));
+  const std::string plan = ReadFile(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
   int cases = ExpectAllRefused("drive_plan", plan, MutateYaml(plan, kEverything), [](const std::string& path) { DrivePlan::Load(path); });
   const std::string map_dir = testing::TempDir("bad_input_map_image");
   garden::OccupancyMap map;

@@ -15,8 +15,8 @@
 #include "reports/run_timing.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
-#include "eval/trial_evaluator.h"
-#include "eval/trial_result.h"
+#include "evaluation/trial_evaluator.h"
+#include "evaluation/trial_result.h"
 #include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cli/drive_command.h"
+#include "runners/drive.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 
@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 TEST(DriveCommand, ShortDriveWritesFramesLogsAndSummary) {
   DriveOptions options;
-  options.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.plan_path = testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml");
   options.output_dir = testing::TempDir("cli_drive");
   fs::remove_all(options.output_dir);
   options.seconds = 3.0;  // 2 s standing, then 1 s driving at up to 25 cm/s

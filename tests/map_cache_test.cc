@@ -1,4 +1,4 @@
-// The visual map cache (scenarios/runner/map_cache.h): its key changes when any input of the map
+// The visual map cache (scenarios/harness/runners/map_cache.h): its key changes when any input of the map
 // changes and not otherwise, and a cached map is found only under its own key.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <functional>
 
-#include "runner/map_cache.h"
+#include "runners/map_cache.h"
 #include "test_support.h"
 
 namespace trimbot {
@@ -36,7 +36,7 @@ class MapCacheKeyTest : public ::testing::Test {
     fs::create_directories(root_ + "/garden_scenes");
     fs::copy(testing::SourcePath("robot"), root_ + "/robot", fs::copy_options::recursive);
     fs::copy(testing::SourcePath("garden_scenes/gardens"), root_ + "/garden_scenes/gardens", fs::copy_options::recursive);
-    fs::copy(testing::SourcePath("scenarios/drives/lawn_loop.yaml"), root_ + "/plan.yaml");
+    fs::copy(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"), root_ + "/plan.yaml");
     recipe_.plan_path = root_ + "/plan.yaml";
     recipe_.descriptor = visual_localization::Descriptor::kUprightSift;
     paths_ = {root_};

@@ -9,11 +9,11 @@
 #include <fstream>
 #include <optional>
 
-#include "runner/closed_loop.h"
-#include "runner/controllers.h"
-#include "runner/drive_plan.h"
-#include "runner/localization_eval.h"
-#include "runner/mapping.h"
+#include "loop/closed_loop.h"
+#include "loop/pilots.h"
+#include "loop/drive_plan.h"
+#include "runners/localization_eval.h"
+#include "runners/mapping.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/robot/camera_rig.h"
@@ -98,7 +98,7 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
 // run them in any order, in parallel).
 scenarios::MapBuildOptions ShortLawnMap(const std::string& dir) {
   scenarios::MapBuildOptions options;
-  options.recipe.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.recipe.plan_path = testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml");
   options.out_dir = dir;
   options.paths = {TRIMBOT_SOURCE_DIR};
   options.recipe.seconds = 7.0;
@@ -131,7 +131,7 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const std::string dir = testing::TempDir("map_for_queries");
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
   const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
-  const scenarios::DrivePlan plan = scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drives/lawn_loop.yaml"));
+  const scenarios::DrivePlan plan = scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
   scenarios::WorldSetup world = plan.world;
   world.seed = 77;
   sim::SimulatorConfig config = scenarios::MakeSimulatorConfig({TRIMBOT_SOURCE_DIR}, world, testing::TempDir("map_query"));
@@ -207,7 +207,7 @@ TEST(LocalizationEval, BenchAndRetrievalOnAQueryDriveBesideTheMappedOne) {
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
   scenarios::LocalizationEvalOptions options;
   options.map_path = dir + "/map.sqlite";
-  options.drive.plan_path = testing::SourcePath("scenarios/drives/lawn_loop.yaml");
+  options.drive.plan_path = testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml");
   options.drive.seconds = 6.0;
   options.drive.interval = 1.0;
   options.drive.lateral_offset = 0.2;

@@ -9,11 +9,11 @@
 #include <regex>
 #include <sstream>
 
-#include "runner/batch.h"
-#include "runner/scenario.h"
+#include "runners/batch.h"
+#include "loop/scenario.h"
 #include "test_support.h"
-#include "runner/prior_knowledge.h"
-#include "runner/trial.h"
+#include "loop/prior_knowledge.h"
+#include "runners/trial.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
@@ -61,7 +61,7 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
 // trials, it has to plan around the bushes).
 TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
   const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/hourglass.yaml"));
-  const garden::OccupancyMap prior = PriorMap(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  const garden::OccupancyMap prior = PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const double radius = stack::PlannerParameters{}.robot_radius;
   Eigen::Vector2d from(s.world.start.x, s.world.start.y);
@@ -167,7 +167,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
            {"{approach_bush: 999}", "has no object 999"}, {"{approach_bush: 5}", "is a hedge, not a bush"}}) {
     const Scenario s = Scenario::Load(SmokeVariant("bad_bush.yaml", "\\{x: 4.0, y: 0.0\\}", goal));
     try {
-      MissionGoals(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+      PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
       ADD_FAILURE() << goal << " accepted";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("bad_bush.yaml"), std::string::npos) << e.what();
@@ -176,7 +176,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
   }
   // A real bush gives the stack its surveyed centre and shape.
   const Scenario ok = Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0\\}", "{approach_bush: 3}"));
-  const std::vector<stack::Goal> goals = MissionGoals(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  const std::vector<stack::Goal> goals = PrepareTrialWorld(ok, ProjectPaths{TRIMBOT_SOURCE_DIR}).mission;
   ASSERT_EQ(goals.size(), 1u);
   ASSERT_TRUE(goals[0].bush.has_value());
   EXPECT_EQ(goals[0].bush->kind, perception::BushShape::Kind::kCylinder);
@@ -188,7 +188,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
 // time; the planner now arrives from a side that works.
 TEST(Planner, ReachesAGoalOnlySomeHeadingsCanArriveAt) {
   Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle.yaml"));
-  const garden::OccupancyMap prior = PriorMap(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  const garden::OccupancyMap prior = PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const stack::GlobalPlanner planner(map, stack::StackParameters::Load(testing::SourcePath("robot/config/stack.yaml")).navigation.planner);
   const Eigen::Vector2d start(0.29, -0.44), goal(0.49, 0.94);
@@ -237,7 +237,8 @@ TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
   const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
   const std::string out = testing::TempDir("trial_faults");
   Scenario clean = Scenario::Load(SmokeVariant("fixes.yaml", "localization: none", "localization: simulated_pose_fixes"));
-  WritePriorMap(PriorMap(clean, paths), out + "/map");
+  const TrialWorld world = PrepareTrialWorld(clean, paths);  // the faults change nothing of it
+  WritePriorMap(world.prior_map, out + "/map");
 
   Scenario faulty = clean;
   sim::Fault dropout;
@@ -252,7 +253,7 @@ TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
   faulty.faults = {dropout, slip};
 
   auto run = [&](const Scenario& s, const std::string& name) {
-    return RunTrial({&s, paths, out + "/map/map.yaml", out + "/" + name, 0, 3});
+    return RunTrial({&s, &world, paths, out + "/map/map.yaml", out + "/" + name, 0, 3});
   };
   const TrialResult a = run(clean, "clean");
   const TrialResult b = run(faulty, "faulty");

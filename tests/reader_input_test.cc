@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bad_input_corpus.h"
-#include "eval/registration_pair_file.h"
+#include "evaluation/registration_pair_file.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_parameters.h"

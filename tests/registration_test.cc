@@ -8,10 +8,10 @@
 #include <cmath>
 #include <random>
 
-#include "cli/registration_command.h"
-#include "cli/registration_cv.h"
-#include "eval/registration_set.h"
-#include "eval/pose_errors.h"
+#include "evaluation/registration_pair_file.h"
+#include "runners/registration_cv.h"
+#include "evaluation/registration_set.h"
+#include "evaluation/pose_errors.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"

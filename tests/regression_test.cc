@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "eval/comparison.h"
-#include "eval/statistics.h"
-#include "runner/batch.h"
-#include "runner/scenario.h"
-#include "runner/sweep.h"
+#include "evaluation/comparison.h"
+#include "evaluation/statistics.h"
+#include "runners/batch.h"
+#include "loop/scenario.h"
+#include "runners/sweep.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/overrides.h"

@@ -11,7 +11,7 @@
 #include "sim_test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/stereo.h"
-#include "eval/stereo_evaluation.h"
+#include "evaluation/stereo_evaluation.h"
 #include "trimbot/robot/robot_description.h"
 
 namespace trimbot::perception {

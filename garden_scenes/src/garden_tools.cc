@@ -135,105 +135,140 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
   return garden;
 }
 
-Garden GenerateGarden(const GeneratorParameters& p) {
-  Rng rng = MakeRng(p.seed, "garden_generator");
-  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * UniformUnit(rng); };
-  Garden garden;
-  garden.name = "generated_" + std::to_string(p.seed);
-  garden.appearance_seed = StreamSeed(p.seed, "garden_appearance") >> 33;  // fits the file's 31-bit seed
-  garden.size = p.size + Eigen::Vector2d(2.0, 2.0);
-  garden.centre = Eigen::Vector2d::Zero();
-  const Eigen::Vector2d half = p.size / 2;
+namespace {
+
+// Draws a garden's layout from one random stream in a fixed order (paths, trees, hedges, topiary,
+// roses, obstacles, fence), so the same seed gives the same garden.
+class GardenGenerator {
+ public:
+  GardenGenerator(const GeneratorParameters& p, Garden* garden)
+      : p_(p), garden_(*garden), rng_(MakeRng(p.seed, "garden_generator")), half_(p.size / 2) {}
 
   // Paths: straight strips across the garden, alternately along x and y.
-  const Surface path_surfaces[] = {Surface::kGravel, Surface::kPavement, Surface::kSoil};
-  for (int i = 0; i < p.paths; ++i) {
-    GroundPatch patch;
-    patch.surface = path_surfaces[i % 3];
-    const bool along_x = i % 2 == 0;
-    const double width = uniform(0.8, 1.5);
-    patch.size = along_x ? Eigen::Vector2d(p.size.x() * uniform(0.5, 0.9), width)
-                         : Eigen::Vector2d(width, p.size.y() * uniform(0.5, 0.9));
-    patch.centre = {uniform(-half.x() + patch.size.x() / 2, half.x() - patch.size.x() / 2),
-                    uniform(-half.y() + patch.size.y() / 2, half.y() - patch.size.y() / 2)};
-    garden.paths.push_back(patch);
+  void AddPaths() {
+    const Surface path_surfaces[] = {Surface::kGravel, Surface::kPavement, Surface::kSoil};
+    for (int i = 0; i < p_.paths; ++i) {
+      GroundPatch patch;
+      patch.surface = path_surfaces[i % 3];
+      const bool along_x = i % 2 == 0;
+      const double width = uniform(0.8, 1.5);
+      patch.size = along_x ? Eigen::Vector2d(p_.size.x() * uniform(0.5, 0.9), width)
+                           : Eigen::Vector2d(width, p_.size.y() * uniform(0.5, 0.9));
+      patch.centre = {uniform(-half_.x() + patch.size.x() / 2, half_.x() - patch.size.x() / 2),
+                      uniform(-half_.y() + patch.size.y() / 2, half_.y() - patch.size.y() / 2)};
+      garden_.paths.push_back(patch);
+    }
   }
 
-  int next_id = 1;
-  // Places an object where it overlaps nothing else, with the robot's clearance; gives up after
-  // a number of tries (a crowded garden just gets fewer objects).
-  auto place = [&](GardenObject object, double margin) {
-    for (int attempt = 0; attempt < 200; ++attempt) {
-      object.position = {uniform(-half.x() + object.size.x() / 2 + 0.5, half.x() - object.size.x() / 2 - 0.5),
-                         uniform(-half.y() + object.size.y() / 2 + 0.5, half.y() - object.size.y() / 2 - 0.5)};
-      bool free = true;
-      for (const auto& other : garden.objects) {
-        if (other.object_class == ObjectClass::kFence) continue;
-        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, other.position,
-                                other.size.head<2>(), other.yaw, margin);
-      }
-      for (const auto& path : garden.paths) {
-        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, path.centre, path.size, path.yaw, 0.1);
-      }
-      if (free) {
-        object.id = next_id++;
-        garden.objects.push_back(object);
-        return &garden.objects.back();
+  // A tree: a trunk placed with the robot's clearance and a crown on it.
+  void AddTrees() {
+    for (int i = 0; i < p_.trees; ++i) {
+      const double crown = uniform(2.4, 3.6);
+      GardenObject trunk = Make(ObjectClass::kTrunk, Shape::kCylinder, {0.3, 0.3, uniform(1.4, 1.8)});
+      if (GardenObject* placed = Place(trunk, p_.robot_clearance)) {
+        GardenObject tree =
+            Make(ObjectClass::kTree, Shape::kEllipsoid, {crown, crown * uniform(0.9, 1.1), uniform(2.5, 3.4)});
+        tree.position = placed->position;
+        tree.base_height = placed->size.z() - 0.3;
+        tree.id = next_id_++;
+        garden_.objects.push_back(tree);
       }
     }
-    return static_cast<GardenObject*>(nullptr);
-  };
-  auto make = [&](ObjectClass c, Shape shape, const Eigen::Vector3d& size, double yaw = 0.0) {
+  }
+
+  void AddHedgesBushesAndObstacles() {
+    for (int i = 0; i < p_.hedges; ++i) {
+      const double length = uniform(2.0, 5.0);
+      Place(Make(ObjectClass::kHedge, Shape::kBox, {length, uniform(0.5, 0.8), uniform(0.4, 1.4)},
+                 UniformUnit(rng_) < 0.5 ? 0.0 : M_PI / 2),
+            p_.robot_clearance);
+    }
+    for (int i = 0; i < p_.topiary; ++i) {
+      const double d = uniform(0.6, 0.9);
+      Place(Make(ObjectClass::kTopiary, UniformUnit(rng_) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
+                 {d, d * uniform(0.9, 1.1), d * uniform(0.6, 1.0)}),
+            p_.robot_clearance);
+    }
+    for (int i = 0; i < p_.roses; ++i) {
+      const double d = uniform(0.5, 0.8);
+      Place(Make(ObjectClass::kRose, Shape::kCylinder, {d, d, uniform(0.5, 0.8)}), p_.robot_clearance);
+    }
+    for (int i = 0; i < p_.obstacles; ++i) {
+      Place(Make(ObjectClass::kObstacle, Shape::kBox, {uniform(0.3, 1.2), uniform(0.3, 1.0), uniform(0.3, 0.9)},
+                 uniform(0.0, M_PI)),
+            p_.robot_clearance);
+    }
+  }
+
+  void AddFence() {
+    if (!p_.fence) return;
+    for (int side = 0; side < 4; ++side) {
+      const bool along_x = side < 2;
+      const double offset = (side % 2 == 0 ? -1 : 1) * (along_x ? half_.y() : half_.x());
+      GardenObject fence = Make(ObjectClass::kFence, Shape::kBox,
+                                along_x ? Eigen::Vector3d(p_.size.x(), 0.1, 0.8) : Eigen::Vector3d(0.1, p_.size.y(), 0.8));
+      fence.position = along_x ? Eigen::Vector2d(0.0, offset) : Eigen::Vector2d(offset, 0.0);
+      fence.id = next_id_++;
+      garden_.objects.push_back(fence);
+    }
+  }
+
+ private:
+  double uniform(double lo, double hi) { return lo + (hi - lo) * UniformUnit(rng_); }
+
+  static GardenObject Make(ObjectClass c, Shape shape, const Eigen::Vector3d& size, double yaw = 0.0) {
     GardenObject o;
     o.object_class = c;
     o.shape = shape;
     o.size = size;
     o.yaw = yaw;
     return o;
-  };
-  for (int i = 0; i < p.trees; ++i) {
-    const double crown = uniform(2.4, 3.6);
-    GardenObject trunk = make(ObjectClass::kTrunk, Shape::kCylinder, {0.3, 0.3, uniform(1.4, 1.8)});
-    if (GardenObject* placed = place(trunk, p.robot_clearance)) {
-      GardenObject tree = make(ObjectClass::kTree, Shape::kEllipsoid, {crown, crown * uniform(0.9, 1.1), uniform(2.5, 3.4)});
-      tree.position = placed->position;
-      tree.base_height = placed->size.z() - 0.3;
-      tree.id = next_id++;
-      garden.objects.push_back(tree);
+  }
+
+  // Places an object where it overlaps nothing else, with the robot's clearance; gives up after
+  // a number of tries (a crowded garden just gets fewer objects).
+  GardenObject* Place(GardenObject object, double margin) {
+    for (int attempt = 0; attempt < 200; ++attempt) {
+      object.position = {uniform(-half_.x() + object.size.x() / 2 + 0.5, half_.x() - object.size.x() / 2 - 0.5),
+                         uniform(-half_.y() + object.size.y() / 2 + 0.5, half_.y() - object.size.y() / 2 - 0.5)};
+      bool free = true;
+      for (const auto& other : garden_.objects) {
+        if (other.object_class == ObjectClass::kFence) continue;
+        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, other.position,
+                                other.size.head<2>(), other.yaw, margin);
+      }
+      for (const auto& path : garden_.paths) {
+        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, path.centre, path.size, path.yaw, 0.1);
+      }
+      if (free) {
+        object.id = next_id_++;
+        garden_.objects.push_back(object);
+        return &garden_.objects.back();
+      }
     }
+    return nullptr;
   }
-  for (int i = 0; i < p.hedges; ++i) {
-    const double length = uniform(2.0, 5.0);
-    place(make(ObjectClass::kHedge, Shape::kBox, {length, uniform(0.5, 0.8), uniform(0.4, 1.4)},
-               UniformUnit(rng) < 0.5 ? 0.0 : M_PI / 2),
-          p.robot_clearance);
-  }
-  for (int i = 0; i < p.topiary; ++i) {
-    const double d = uniform(0.6, 0.9);
-    place(make(ObjectClass::kTopiary, UniformUnit(rng) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
-               {d, d * uniform(0.9, 1.1), d * uniform(0.6, 1.0)}),
-          p.robot_clearance);
-  }
-  for (int i = 0; i < p.roses; ++i) {
-    const double d = uniform(0.5, 0.8);
-    place(make(ObjectClass::kRose, Shape::kCylinder, {d, d, uniform(0.5, 0.8)}), p.robot_clearance);
-  }
-  for (int i = 0; i < p.obstacles; ++i) {
-    place(make(ObjectClass::kObstacle, Shape::kBox, {uniform(0.3, 1.2), uniform(0.3, 1.0), uniform(0.3, 0.9)},
-               uniform(0.0, M_PI)),
-          p.robot_clearance);
-  }
-  if (p.fence) {
-    for (int side = 0; side < 4; ++side) {
-      const bool along_x = side < 2;
-      const double offset = (side % 2 == 0 ? -1 : 1) * (along_x ? half.y() : half.x());
-      GardenObject fence = make(ObjectClass::kFence, Shape::kBox,
-                                along_x ? Eigen::Vector3d(p.size.x(), 0.1, 0.8) : Eigen::Vector3d(0.1, p.size.y(), 0.8));
-      fence.position = along_x ? Eigen::Vector2d(0.0, offset) : Eigen::Vector2d(offset, 0.0);
-      fence.id = next_id++;
-      garden.objects.push_back(fence);
-    }
-  }
+
+  const GeneratorParameters& p_;
+  Garden& garden_;
+  Rng rng_;
+  Eigen::Vector2d half_;
+  int next_id_ = 1;
+};
+
+}  // namespace
+
+Garden GenerateGarden(const GeneratorParameters& p) {
+  Garden garden;
+  garden.name = "generated_" + std::to_string(p.seed);
+  garden.appearance_seed = StreamSeed(p.seed, "garden_appearance") >> 33;  // fits the file's 31-bit seed
+  garden.size = p.size + Eigen::Vector2d(2.0, 2.0);
+  garden.centre = Eigen::Vector2d::Zero();
+  GardenGenerator generator(p, &garden);
+  generator.AddPaths();
+  generator.AddTrees();
+  generator.AddHedgesBushesAndObstacles();
+  generator.AddFence();
   return garden;
 }
 

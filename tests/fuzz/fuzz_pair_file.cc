@@ -1,5 +1,5 @@
 // libFuzzer target: the registration pair file reader.
-#include "eval/registration_pair_file.h"
+#include "evaluation/registration_pair_file.h"
 #include "fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -1,8 +1,8 @@
 // libFuzzer target: the same bytes as a scenario (with the overrides a user can add on the command
 // line) and as a drive plan.
 #include "fuzz_input.h"
-#include "runner/drive_plan.h"
-#include "runner/scenario.h"
+#include "loop/drive_plan.h"
+#include "loop/scenario.h"
 #include "trimbot/common/overrides.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

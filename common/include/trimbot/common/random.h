@@ -17,7 +17,7 @@ inline std::uint64_t SplitMix64(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-// 64-bit FNV-1a of a text: stream names here, cache keys elsewhere (scenarios/runner/map_cache.cc).
+// 64-bit FNV-1a of a text: stream names here, cache keys elsewhere (scenarios/harness/runners/map_cache.cc).
 inline std::uint64_t Fnv1a(std::string_view text) {
   std::uint64_t h = 1469598103934665603ULL;
   for (char c : text) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;

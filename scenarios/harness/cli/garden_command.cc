@@ -1,0 +1,82 @@
+// `trimbot garden import-csv | generate | export` (runners/garden_files.h).
+#include <memory>
+
+#include "cli/command.h"
+#include "runners/garden_files.h"
+#include "trimbot/common/input_error.h"
+
+namespace trimbot::scenarios {
+namespace {
+
+struct GardenOptions {
+  std::string input;
+  std::string output;
+  std::string name;
+  double ground_z = 0.0;
+  garden::GeneratorParameters generator;
+  std::string size = "16x12";
+  double resolution = 0.05;
+  double clearance = 1.0;
+  double growth = 0.0;
+  double point_density = 400.0;
+};
+
+}  // namespace
+
+void AddGardenCommands(Commands& commands) {
+  auto options = std::make_shared<GardenOptions>();
+  auto* garden_cmd = commands.app().add_subcommand("garden", "import, generate and export gardens");
+  garden_cmd->require_subcommand(1);
+
+  auto* import_cmd = garden_cmd->add_subcommand("import-csv", "convert a GardenUI object map (CSV) to a garden file");
+  import_cmd->add_option("csv", options->input, "object map")->required();
+  import_cmd->add_option("--name", options->name, "garden name")->required()->check(CLI::Validator(
+      [](std::string& name) { return IsPlainName(name) ? std::string() : "'" + name + "' is not a plain name"; },
+      "NAME"));
+  import_cmd->add_option("--ground-z", options->ground_z, "z of the ground in the CSV (Wageningen: -1.48)")
+      ->check(CLI::Range(-1e4, 1e4));
+  import_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");
+  commands.OnRun(import_cmd, [options] {
+    return ImportGardenCsv(options->input, options->name, options->ground_z, options->output);
+  });
+
+  auto* generate_cmd = garden_cmd->add_subcommand("generate", "make a new garden from a seed and a few parameters");
+  auto& g = options->generator;
+  generate_cmd->add_option("--seed", g.seed, "seed (the same seed gives the same garden)")->required();
+  generate_cmd->add_option("--size", options->size, "extent WxH in metres, e.g. 16x12");
+  generate_cmd->add_option("--topiary", g.topiary, "number of topiary bushes")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--roses", g.roses, "number of rose bushes")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--hedges", g.hedges, "number of hedges")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--trees", g.trees, "number of trees")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--obstacles", g.obstacles, "number of other obstacles")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--paths", g.paths, "number of paths (gravel, pavement, soil in turn)")->check(CLI::Range(0, 100));
+  generate_cmd->add_option("--clearance", g.robot_clearance, "free space kept between objects (m)")->check(CLI::Range(0.0, 10.0));
+  generate_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");
+  commands.OnRun(generate_cmd, [options] {
+    options->generator.size = ParseGardenSize(options->size);
+    return GenerateGardenFile(options->generator, "--seed " + std::to_string(options->generator.seed) + " --size " +
+                                                      options->size, options->output);
+  });
+
+  auto* export_cmd = garden_cmd->add_subcommand("export", "write the occupancy map (map_server) and ground-truth PLY");
+  export_cmd->add_option("garden", options->input, "garden name or file")->required();
+  export_cmd->add_option("--out", options->output, "output folder")->required();
+  export_cmd->add_option("--resolution", options->resolution, "occupancy cell size (m)")->check(CLI::Range(0.005, 10.0));
+  export_cmd->add_option("--clearance", options->clearance,
+                         "objects starting higher than this (tree crowns) are not obstacles (m)")
+      ->check(CLI::Range(0.0, 100.0));
+  export_cmd->add_option("--growth", options->growth, "seasonal growth 0..1")->check(CLI::Range(0.0, 1.0));
+  export_cmd->add_option("--points-per-m2", options->point_density, "PLY sampling density")->check(CLI::Range(1.0, 1e5));
+  commands.OnRun(export_cmd, [options, &commands] {
+    GardenExport exported;
+    exported.garden = options->input;
+    exported.output_dir = options->output;
+    exported.resolution = options->resolution;
+    exported.clearance = options->clearance;
+    exported.growth = options->growth;
+    exported.point_density = options->point_density;
+    return ExportGarden(exported, commands.paths());
+  });
+}
+
+}  // namespace trimbot::scenarios

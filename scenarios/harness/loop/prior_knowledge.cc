@@ -1,0 +1,158 @@
+#include "loop/prior_knowledge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
+#include "trimbot/common/rotation.h"
+#include "trimbot/garden/conditions.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_files.h"
+
+namespace trimbot::scenarios {
+
+garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
+  garden::Garden surveyed = built;
+  try {
+    garden::Garden world = built;  // checked here, before any trial: placed by the simulator
+    world.AddObjects(survey.unmapped_objects);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(scenario_file, std::string("survey.unmapped_objects: ") + e.what());
+  }
+  for (int id : survey.unmapped) {
+    const auto it = std::find_if(surveyed.objects.begin(), surveyed.objects.end(),
+                                 [id](const garden::GardenObject& o) { return o.id == id; });
+    if (it == surveyed.objects.end()) {
+      throw InputError(scenario_file, "survey.unmapped: garden '" + built.name + "' has no object " + std::to_string(id));
+    }
+    surveyed.objects.erase(it);
+  }
+  // Foliage grown at survey time: its outline pushed out by the growth on every side.
+  for (auto& object : surveyed.objects) {
+    if (garden::IsFoliage(object.object_class)) {
+      object.size.head<2>() += Eigen::Vector2d::Constant(2.0 * survey.growth * garden::kMaxGrowth);
+    }
+  }
+  surveyed.objects.insert(surveyed.objects.end(), survey.gone.begin(), survey.gone.end());
+  return surveyed;
+}
+
+garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed) {
+  return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, scenario.map_clearance_height);
+}
+
+std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir) {
+  garden::WriteOccupancyMap(map, dir, "map");
+  return dir + "/map.yaml";
+}
+
+const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const Scenario& scenario,
+                                   const std::string& what) {
+  const auto it = std::find_if(garden.objects.begin(), garden.objects.end(),
+                               [id](const garden::GardenObject& o) { return o.id == id; });
+  if (it == garden.objects.end()) {
+    throw InputError(scenario.source, what + ": the garden '" + garden.name + "' has no object " + std::to_string(id));
+  }
+  if (it->object_class != garden::ObjectClass::kTopiary && it->object_class != garden::ObjectClass::kRose) {
+    throw InputError(scenario.source, what + ": object " + std::to_string(id) + " is a " +
+                                          garden::ToString(it->object_class) + ", not a bush (topiary or rose)");
+  }
+  return *it;
+}
+
+namespace {
+
+std::string ApproachBush(int id) { return "goals: approach_bush " + std::to_string(id); }
+
+perception::BushShape ShapeOf(const garden::GardenObject& object) {
+  perception::BushShape shape;
+  shape.kind = object.shape == garden::Shape::kEllipsoid ? perception::BushShape::Kind::kEllipsoid
+               : object.shape == garden::Shape::kCylinder ? perception::BushShape::Kind::kCylinder
+                                                          : perception::BushShape::Kind::kBox;
+  shape.size = object.size;
+  shape.base_height = object.base_height;
+  shape.yaw = object.yaw;
+  return shape;
+}
+
+}  // namespace
+
+std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Garden& surveyed) {
+  std::vector<stack::Goal> goals;
+  for (const ScenarioGoal& goal : scenario.goals) {
+    if (goal.bush == 0) {
+      goals.emplace_back(goal.position);
+      continue;
+    }
+    const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario, ApproachBush(goal.bush));
+    goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
+  }
+  return goals;
+}
+
+stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
+  Rng rng = MakeRng(seed, "initial_pose");
+  const double dx = StandardNormal(rng), dy = StandardNormal(rng), dyaw = StandardNormal(rng);
+  const sim::Pose2D& start = scenario.world.start;
+  return {start.x + scenario.initial_position_sigma * dx, start.y + scenario.initial_position_sigma * dy,
+          std::remainder(start.yaw + scenario.initial_yaw_sigma * dyaw, 2.0 * M_PI)};
+}
+
+namespace {
+
+Eigen::Isometry3d SmallMotion(Rng& rng, double rotation_sigma, double translation_sigma) {
+  const auto w = StandardNormalVector<Eigen::Vector3d>(rng);
+  const auto t = StandardNormalVector<Eigen::Vector3d>(rng);
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  motion.linear() = RotationFromVector(rotation_sigma * w);
+  motion.translation() = translation_sigma * t;
+  return motion;
+}
+
+}  // namespace
+
+std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, std::uint64_t seed,
+                             const std::string& dir) {
+  const robot::RobotFiles files = paths.robot_files();
+  const CalibrationError& error = scenario.calibration_error;
+  if (!error.any()) return files.camchain;
+  const robot::CameraRig truth = robot::LoadCameraRig(files);
+  Rng rng = MakeRng(seed, "calibration_error");
+  std::vector<robot::CameraCalibration> cameras = truth.cameras();
+  for (auto& camera : cameras) {
+    auto& k = camera.intrinsics;
+    const double scale = 1.0 + error.focal_relative * StandardNormal(rng);
+    k.fx *= scale;
+    k.fy *= scale;
+    k.cx += error.principal_point_px * StandardNormal(rng);
+    k.cy += error.principal_point_px * StandardNormal(rng);
+    const Eigen::Isometry3d motion = SmallMotion(rng, error.rotation_deg * M_PI / 180.0, error.translation_m);
+    // cam0's pose on the robot comes from the URDF; the chain to the others is the camchain's.
+    if (camera.index > 0) camera.T_base_camera = camera.T_base_camera * motion;
+  }
+  const std::string path = dir + "/stack_camchain.yaml";
+  WriteFileAtomically(path, robot::CameraRig::FromCameras(cameras, path).ToKalibrYaml());
+  return path;
+}
+
+stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths) {
+  const stack::StackParameters defaults = stack::StackParameters::Load(paths.robot_files().stack_parameters);
+  const stack::StackParameters parameters = scenario.stack ? defaults.Overridden(*scenario.stack) : defaults;
+  if (scenario.simulated_pose_fixes_given && parameters.localization != stack::LocalizationSource::kSimulatedPoseFixes) {
+    throw InputError(scenario.source, std::string("simulated_pose_fixes: settings given, but the stack's localization is '") +
+                                          stack::ToString(parameters.localization) +
+                                          "' (set stack: {localization: simulated_pose_fixes} to use them)");
+  }
+  if (parameters.localization == stack::LocalizationSource::kVisual && scenario.visual_map.empty() &&
+      !scenario.visual_map_recipe) {
+    throw InputError(scenario.source, "the stack's localization is 'visual', but the scenario names no visual_map "
+                                      "(a map file, or {mapping_drive: PLAN} to build one on first use)");
+  }
+  return parameters;
+}
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,48 @@
+#pragma once
+// What the robot knows before a trial, made from the scenario and the world honestly: the prior
+// map from the garden as surveyed (not the simulated geometry), where it was put down (the true
+// start plus the scenario's placement error), the calibration file it reads (the true one plus
+// the scenario's calibration error), and its software's parameters (robot/config/stack.yaml with
+// the scenario's `stack:` overrides). The simulator never sees any of these.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "loop/scenario.h"
+#include "loop/world_setup.h"
+#include "trimbot/garden/garden.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/stack/robot_stack.h"
+
+namespace trimbot::scenarios {
+
+// The garden as the survey recorded it: foliage at the survey's growth, unmapped objects left
+// out, objects that are gone still in. Throws InputError (naming the scenario) for an unknown id.
+garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file);
+
+// The robot's prior map: the surveyed garden's objects below the scenario's clearance height.
+garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed);
+// Writes it (map_server) as <dir>/map.{png,yaml}; returns the YAML's path.
+std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir);
+
+// The mission as the stack gets it: point goals as given; bush goals with the bush as surveyed
+// (centre, shape, yaw). Throws InputError naming the scenario for a bush the surveyed garden lacks
+// or an object that is not a bush (topiary or rose).
+std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Garden& surveyed);
+// Object `id` of `garden`, which must be a bush (topiary or rose); InputError naming the scenario
+// and `what` (where the id was given, e.g. "goals: approach_bush 3") otherwise.
+const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const Scenario& scenario,
+                                   const std::string& what);
+
+// Where the operator believes the robot stands: the true start with seeded placement error.
+stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed);
+
+// The camchain the stack reads: the true calibration, or with the scenario's seeded calibration
+// error written to <dir>/stack_camchain.yaml. Returns the file's path.
+std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, std::uint64_t seed,
+                             const std::string& dir);
+
+// The stack's parameters for this scenario. Throws InputError naming the file and key.
+stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths);
+
+}  // namespace trimbot::scenarios

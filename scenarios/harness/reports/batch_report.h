@@ -1,0 +1,34 @@
+#pragma once
+// Report files of a batch: JUnit XML for CI (one test case per pass criterion, plus one per trial),
+// and PNG plots - trajectories over the robot's map (as Figures 13/14 of the reference deliverable)
+// and histograms of the localization errors (as Figure 12). All files are written atomically.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "evaluation/trial_result.h"
+#include "trimbot/garden/garden_tools.h"
+
+namespace trimbot::scenarios {
+
+struct PlotTrajectory {
+  int trial = 0;
+  bool success = false;
+  std::vector<Eigen::Vector2d> ground_truth;  // map frame, metres
+  std::vector<Eigen::Vector2d> estimate;      // the EKF's estimate
+};
+
+void WriteJunitXml(const std::string& path, const BatchSummary& summary);
+// `map`: the robot's prior map; `world`: the garden as it really is on the same cells (what the
+// map lacks is drawn in its own colour).
+void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
+                         const std::vector<PlotTrajectory>& trajectories,
+                         const std::vector<Eigen::Vector2d>& goals, const std::string& title);
+// One panel per estimate name found in the trials (position error in centimetres).
+void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult>& trials,
+                          const std::string& title);
+// x, y of each line of a TUM trajectory file ("t x y z qx qy qz qw"; # comments skipped).
+// Throws InputError naming the file and line when it is malformed.
+std::vector<Eigen::Vector2d> ReadTumPositions(const std::string& path);
+
+}  // namespace trimbot::scenarios

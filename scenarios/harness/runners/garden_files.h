@@ -1,0 +1,32 @@
+#pragma once
+// `trimbot garden ...`: gardens imported from GardenUI object maps, generated from a seed, and
+// exported as an occupancy map and a ground-truth point cloud.
+#include <string>
+
+#include "loop/world_setup.h"
+#include "trimbot/garden/garden_tools.h"
+
+namespace trimbot::scenarios {
+
+// A GardenUI object map (CSV) as a garden file named `name` at `output` ("" or "-": standard output).
+int ImportGardenCsv(const std::string& csv, const std::string& name, double ground_z, const std::string& output);
+
+// "WxH" in metres, both in (2, garden::kMaxGardenExtent]; InputError naming --size otherwise.
+Eigen::Vector2d ParseGardenSize(const std::string& text);
+// A garden made from `parameters` at `output` ("" or "-": standard output); `arguments` are quoted
+// in the file's first comment, to make it again.
+int GenerateGardenFile(const garden::GeneratorParameters& parameters, const std::string& arguments,
+                       const std::string& output);
+
+struct GardenExport {
+  std::string garden;        // name or file
+  std::string output_dir;
+  double resolution = 0.05;  // m per occupancy cell
+  double clearance = 1.0;    // m: objects starting higher (tree crowns) are not obstacles
+  double growth = 0.0;       // seasonal growth 0..1 of the point cloud's foliage
+  double point_density = 400.0;  // PLY points per m^2
+};
+// Writes <garden>_occupancy.{png,yaml} (map_server) and <garden>_ground_truth.ply.
+int ExportGarden(const GardenExport& options, const ProjectPaths& paths);
+
+}  // namespace trimbot::scenarios

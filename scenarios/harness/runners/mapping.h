@@ -1,0 +1,35 @@
+#pragma once
+// `trimbot map build`: a mapping drive - a drive plan played open loop, or a scenario whose goals
+// the robot's stack drives to (on the simulated pose fixes or dead reckoning, as the map does not
+// exist yet; with a seed 1000 above the scenario's) - rendered only where the map builder takes a
+// keyframe, with survey poses = ground truth + seeded noise (as the real map was tied to a laser
+// tracker), through the stack's MapBuilder into one map file. Writes into the output folder:
+//   map.sqlite        the map (VisualMap)
+//   map_stats.json    keyframes, points, observations, mean track length, reprojection RMSE, time
+//                     per stage, keyframe pose errors against ground truth (survey and adjusted)
+//   map_top_view.png  points over the garden, keyframe poses
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "loop/map_recipe.h"
+#include "loop/world_setup.h"
+#include "trimbot/visual_localization/features.h"
+#include "trimbot/visual_localization/map_builder.h"
+
+namespace trimbot::scenarios {
+
+struct MapBuildOptions {
+  MapRecipe recipe;
+  std::string out_dir;
+  ProjectPaths paths;
+};
+
+int RunMapBuild(const MapBuildOptions& options);
+
+// The map builder's settings for a recipe whose descriptor is `descriptor`: what RunMapBuild uses,
+// and what a cached map's key records.
+visual_localization::MapBuilderOptions MapBuilderOptionsFor(const MapRecipe& recipe,
+                                                            visual_localization::Descriptor descriptor);
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,21 @@
+#pragma once
+// A goal of the stack's mission (RobotStack::SetGoals).
+#include <Eigen/Core>
+#include <optional>
+
+#include "trimbot/perception/bush_estimator.h"
+
+namespace trimbot::stack {
+
+// A goal of the mission: a point to drive to, or a bush to approach for trimming (by map to an
+// approach point, then by visual servoing until the arm's axis stands at the standoff).
+struct Goal {
+  Goal(const Eigen::Vector2d& point) : position(point) {}  // NOLINT(google-explicit-constructor): a point is a goal
+  Goal(double x, double y) : position(x, y) {}
+  // The bush as the survey knows it: its centre in the map and its shape (yaw in the map frame).
+  static Goal ApproachBush(const Eigen::Vector2d& centre, const perception::BushShape& shape);
+  Eigen::Vector2d position;                   // the point, or the bush's surveyed centre
+  std::optional<perception::BushShape> bush;  // set for a bush approach
+};
+
+}  // namespace trimbot::stack

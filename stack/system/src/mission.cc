@@ -1,0 +1,228 @@
+#include "mission.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "scoped_timer.h"
+
+namespace trimbot::stack {
+namespace {
+
+// A planar point through a (planar) transform.
+Eigen::Vector2d Apply(const Eigen::Isometry3d& T, const Eigen::Vector2d& p) {
+  return (T * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>();
+}
+
+MissionState ToMission(Navigator::Mode mode) {
+  switch (mode) {
+    case Navigator::Mode::kIdle: return MissionState::kIdle;
+    case Navigator::Mode::kFollowing:
+    case Navigator::Mode::kBackingOff: return MissionState::kDriving;
+    case Navigator::Mode::kDone: return MissionState::kDone;
+    case Navigator::Mode::kFailed: return MissionState::kFailed;
+  }
+  return MissionState::kIdle;
+}
+
+}  // namespace
+
+const char* ToString(MissionState state) {
+  switch (state) {
+    case MissionState::kIdle: return "idle";
+    case MissionState::kDriving: return "driving";
+    case MissionState::kReaching: return "reaching";
+    case MissionState::kDone: return "done";
+    case MissionState::kFailed: return "failed";
+  }
+  return "?";
+}
+
+Goal Goal::ApproachBush(const Eigen::Vector2d& centre, const perception::BushShape& shape) {
+  Goal goal(centre);
+  goal.bush = shape;
+  return goal;
+}
+
+bool HasBushGoal(const std::vector<Goal>& goals) {
+  return std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
+}
+
+Mission::Mission(const StackParameters& parameters, const Eigen::Vector2d& arm_axis, const Ekf& ekf,
+                 const GyroOdometry& servo_odometry, arm::ArmExecutive* arm)
+    : parameters_(parameters),
+      arm_axis_(arm_axis),
+      ekf_(ekf),
+      servo_odometry_(servo_odometry),
+      arm_(arm),
+      servo_(parameters.bush_approach.servo, arm_axis) {}
+
+void Mission::SetGoals(const std::vector<Goal>& goals) {
+  goals_ = goals;
+  next_goal_ = 0;
+  failed_ = false;
+}
+
+void Mission::SetArmGoals(const std::vector<Eigen::Isometry3d>& cutter_poses) {
+  arm_->SetGoals(cutter_poses);
+  arm_goals_ = !cutter_poses.empty();
+}
+
+Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& from,
+                                       const Navigator& navigator) const {
+  // Of the sides of the bush where the footprint at the standoff clears the map (other than the
+  // bush), the nearest to where the robot comes from whose approach point can be arrived at from
+  // any direction (RRT* reaches a goal only along an edge from its nearest node, so a goal some
+  // headings cannot arrive at makes it fail at random); failing that, one the planner accepts at all.
+  const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
+  const double reach = standoff + parameters_.bush_approach.approach_margin + arm_axis_.x();
+  // Sides every 10 deg; a box only towards its corners (+-15 deg), where two faces show: seen
+  // face-on, a box's centre along the face rests on its two leafy edges alone (3 deg off measured).
+  std::vector<double> sides;
+  if (goal.bush->kind == perception::BushShape::Kind::kBox) {
+    for (int k = 0; k < 4; ++k) {
+      for (double offset : {0.0, -15.0, 15.0}) {
+        sides.push_back(goal.bush->yaw + (45.0 + 90.0 * k + offset) * M_PI / 180.0);
+      }
+    }
+  } else {
+    for (int k = 0; k < 36; ++k) sides.push_back(2.0 * M_PI * k / 36.0);
+  }
+  for (const double clearance : {navigator.ArrivalClearance(), parameters_.navigation.planner.robot_radius}) {
+    std::optional<Eigen::Vector2d> best;
+    for (const double angle : sides) {
+      const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
+      const Eigen::Vector2d approach = goal.position + reach * side;
+      const Eigen::Vector2d at_standoff = goal.position + (standoff + arm_axis_.x()) * side;
+      const Pose2 facing{at_standoff.x(), at_standoff.y(), angle + M_PI};
+      if (navigator.costmap().DistanceToObstacle(approach) < clearance ||
+          navigator.FootprintClearance(facing) < 2.0 * parameters_.navigation.stop_clearance) {
+        continue;
+      }
+      if (!best || (approach - from).norm() < (*best - from).norm()) best = approach;
+    }
+    if (best) return *best;
+  }
+  // No side is free: straight from where the robot comes (the navigator moves the point or says why).
+  const Eigen::Vector2d away = (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized()
+                                                                      : Eigen::Vector2d(-1.0, 0.0);
+  return goal.position + reach * away;
+}
+
+void Mission::StartSegment(Navigator* navigator) {
+  const Pose2 estimate = ekf_.Estimate().pose;
+  Eigen::Vector2d from(estimate.x, estimate.y);
+  std::vector<Eigen::Vector2d> points;
+  bush_goal_ = -1;
+  servoing_ = false;
+  for (int i = next_goal_; i < static_cast<int>(goals_.size()); ++i) {
+    const Goal& goal = goals_[static_cast<std::size_t>(i)];
+    if (goal.bush) {
+      points.push_back(ApproachPoint(goal, from, *navigator));
+      bush_goal_ = i;
+      break;
+    }
+    points.push_back(goal.position);
+    from = goal.position;
+  }
+  navigator->SetGoals(points, next_goal_);
+  if (bush_goal_ >= 0) {
+    ExpectBush();
+    bush_status_ = BushApproachStatus{};
+    bush_status_.goal = bush_goal_;
+    bush_status_.target_distance = servo_.target_distance();
+    bush_status_.target_bearing = parameters_.bush_approach.servo.bearing;
+  }
+}
+
+void Mission::ExpectBush() {
+  const Goal& goal = goals_[static_cast<std::size_t>(bush_goal_)];
+  servo_.Expect(Apply(MapFromServoFrame().inverse(), goal.position), goal.bush->Radius());
+}
+
+void Mission::CountSighting(bool tracked) {
+  ++bush_status_.frames;
+  bush_status_.tracked += tracked ? 1 : 0;
+}
+
+Eigen::Isometry3d Mission::MapFromServoFrame() const {
+  // The EKF's map pose of base_link and the gyro odometry's pose of it, at the same time.
+  return ToIsometry(ekf_.Estimate().pose) * ToIsometry(servo_odometry_.pose()).inverse();
+}
+
+void Mission::HandleNavigationEvents(double stamp, Telemetry* telemetry) {
+  for (NavigationEvent& event : telemetry->events) {
+    if (event.type != NavigationEvent::Type::kGoalReached || event.goal != bush_goal_) continue;
+    // By map at the bush's approach point: the bush goal itself is reached by visual servoing.
+    event.type = NavigationEvent::Type::kApproachReached;
+    servoing_ = true;
+    servo_.Start(stamp);
+  }
+}
+
+void Mission::RunBushServo(double stamp, Navigator* navigator, messages::RobotCommands* commands,
+                           Telemetry* telemetry) {
+  commands->base = servo_.Update(stamp, servo_odometry_.pose());
+  if (servo_.mode() == BushServo::Mode::kDone) {
+    const Eigen::Vector2d db = servo_.DistanceBearing(servo_odometry_.pose());
+    FinishBushGoal(stamp, true, std::to_string(db.x()) + " m, " + std::to_string(db.y() * 180.0 / M_PI) + " deg",
+                   navigator, telemetry);
+  } else if (servo_.mode() == BushServo::Mode::kFailed) {
+    FinishBushGoal(stamp, false, servo_.failure(), navigator, telemetry);
+  }
+}
+
+void Mission::FinishBushGoal(double stamp, bool reached, const std::string& detail, Navigator* navigator,
+                             Telemetry* telemetry) {
+  NavigationEvent event;
+  event.stamp = stamp;
+  event.type = reached ? NavigationEvent::Type::kGoalReached : NavigationEvent::Type::kGoalFailed;
+  event.goal = bush_goal_;
+  event.detail = detail;
+  event.position = Apply(MapFromServoFrame(), servo_.centre());  // the bush's centre as tracked
+  telemetry->events.push_back(event);
+  servoing_ = false;
+  if (!reached) {
+    failed_ = true;
+    return;
+  }
+  next_goal_ = bush_goal_ + 1;
+  StartSegment(navigator);  // the rest of the mission (none: the navigator is done)
+}
+
+void Mission::UpdateTelemetry(const Navigator& navigator, Telemetry* telemetry) {
+  state_ = failed_ ? MissionState::kFailed : servoing_ ? MissionState::kDriving : ToMission(navigator.mode());
+  telemetry->mission = state_;
+  telemetry->current_goal = servoing_ || failed_ ? bush_goal_ : navigator.current_goal();
+  if (bush_goal_ < 0) {
+    telemetry->bush.reset();
+    return;
+  }
+  bush_status_.mode = servoing_ ? ToString(servo_.mode()) : "navigating";
+  const Eigen::Vector2d db = servo_.DistanceBearing(servo_odometry_.pose());
+  bush_status_.distance = db.x();
+  bush_status_.bearing = db.y();
+  telemetry->bush = bush_status_;
+}
+
+bool Mission::NavigationGoalsDone() const {
+  return goals_.empty() || state_ == MissionState::kDone || state_ == MissionState::kReaching;
+}
+
+void Mission::RunArm(double stamp, messages::RobotCommands* commands, Telemetry* telemetry) {
+  ScopedTimer timer(&telemetry->timings.arm);
+  if (state_ == MissionState::kFailed || !NavigationGoalsDone()) return;
+  if (auto command = arm_->Update(stamp)) commands->arm = *command;
+  telemetry->arm_results = arm_->TakeResults();
+  ArmStatus status;
+  status.mode = arm::ToString(arm_->mode());
+  status.goal = arm_->current_goal();
+  status.perceived_cells = arm_->perceived_cells();
+  status.target.assign(arm_->target().data(), arm_->target().data() + arm_->target().size());
+  telemetry->arm = status;
+  state_ = arm_->mode() == arm::ArmExecutive::Mode::kDone ? MissionState::kDone : MissionState::kReaching;
+  telemetry->mission = state_;
+}
+
+}  // namespace trimbot::stack
