@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <sstream>
 
 #include "sim_test_support.h"
 #include "trimbot/sim/base_controller.h"
@@ -268,6 +269,117 @@ TEST(World, TheGardensLookDoesNotDependOnTheRunSeed) {
   const garden::Garden lawn = garden::Garden::Load(TestLawn());
   EXPECT_EQ(lawn.appearance_seed, garden::Garden::Load(TestLawn()).appearance_seed);
   EXPECT_NE(lawn.appearance_seed, garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml")).appearance_seed);
+}
+
+}  // namespace
+}  // namespace trimbot::sim
+
+namespace trimbot::sim {
+namespace {
+
+std::string NominalRobotMjcfPath() { return testing::SourcePath("robot/") + kRobotMjcfFile; }
+
+// The robot's MJCF is a model of its own: robot/mjcf/trimbot.xml compiles without the garden and
+// holds what the simulator drives and reads (the URDF's joints, the ring's cameras, the actuators,
+// the IMU's sensors).
+TEST(RobotMjcf, LoadsOnItsOwn) {
+  char error[1024] = "";
+  mjModel* m = mj_loadXML(NominalRobotMjcfPath().c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(m, nullptr) << error;
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  // The robot alone: no garden (meshes, textures, lights) and nothing in the world body.
+  EXPECT_EQ(m->nmesh, 0);
+  EXPECT_EQ(m->ntex, 0);
+  EXPECT_EQ(m->nlight, 0);
+  for (int g = 0; g < m->ngeom; ++g) EXPECT_GT(m->geom_bodyid[g], 0) << mj_id2name(m, mjOBJ_GEOM, g);
+  EXPECT_STREQ(mj_id2name(m, mjOBJ_BODY, 1), robot::RobotFrames::kBase);
+  EXPECT_EQ(m->jnt_type[m->body_jntadr[1]], mjJNT_FREE);
+  // Every moving URDF joint, a hinge.
+  int hinges = 0;
+  for (const auto& [name, joint] : robot.urdf().joints_) {
+    if (joint->type == urdf::Joint::FIXED) continue;
+    const int id = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    ASSERT_GE(id, 0) << name;
+    EXPECT_EQ(m->jnt_type[id], mjJNT_HINGE) << name;
+    ++hinges;
+  }
+  EXPECT_EQ(hinges, 9);
+  EXPECT_EQ(m->njnt, 1 + hinges);
+  // The actuators: the wheels' motors, the arm's servos, the cutter's motor, each on its joint.
+  std::vector<std::pair<std::string, std::string>> actuators = {
+      {"left_wheel_joint_motor", robot::RobotFrames::kLeftWheelJoint},
+      {"right_wheel_joint_motor", robot::RobotFrames::kRightWheelJoint}};
+  for (const auto& joint : robot.ArmJointNames()) actuators.push_back({joint + "_servo", joint});
+  actuators.push_back({"cutter_motor", robot::RobotFrames::kCutterJoint});
+  ASSERT_EQ(actuators.size(), 2u + messages::kArmJoints + 1u);
+  EXPECT_EQ(m->nu, static_cast<int>(actuators.size()));
+  for (const auto& [actuator, joint] : actuators) {
+    const int id = mj_name2id(m, mjOBJ_ACTUATOR, actuator.c_str());
+    ASSERT_GE(id, 0) << actuator;
+    EXPECT_EQ(m->actuator_trnid[2 * id], mj_name2id(m, mjOBJ_JOINT, joint.c_str())) << actuator;
+  }
+  // The ring's ten cameras on camera_ring_link, cam0 ... cam9 in the rig's order.
+  ASSERT_EQ(m->ncam, 10);
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(mj_name2id(m, mjOBJ_CAMERA, ("cam" + std::to_string(i)).c_str()), i);
+    EXPECT_STREQ(mj_id2name(m, mjOBJ_BODY, m->cam_bodyid[i]), robot::RobotFrames::kCameraRing);
+  }
+  // The IMU: accelerometer and gyro at imu_link.
+  const int site = mj_name2id(m, mjOBJ_SITE, robot::RobotFrames::kImu);
+  ASSERT_GE(site, 0);
+  EXPECT_EQ(m->nsensor, 2);
+  for (const auto& [sensor, type] : {std::pair{"imu_accelerometer", mjSENS_ACCELEROMETER}, std::pair{"imu_gyro", mjSENS_GYRO}}) {
+    const int id = mj_name2id(m, mjOBJ_SENSOR, sensor);
+    ASSERT_GE(id, 0) << sensor;
+    EXPECT_EQ(m->sensor_type[id], type) << sensor;
+    EXPECT_EQ(m->sensor_objid[id], site) << sensor;
+  }
+  // It simulates: a second of free fall with the arm held.
+  mjData* d = mj_makeData(m);
+  while (d->time < 1.0) mj_step(m, d);
+  EXPECT_NEAR(d->qpos[2], -0.5 * 9.81, 0.05);
+  for (int w = 0; w < mjNWARNING; ++w) EXPECT_EQ(d->warning[w].number, 0) << "MuJoCo warning " << w;
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
+// The checked-in file cannot go stale: it is what the URDF and the nominal calibration give
+// (after a change, trimbot_robot_mjcf robot/ rewrites it).
+TEST(RobotMjcf, IsWhatTheUrdfAndTheNominalCalibrationGive) {
+  std::istringstream file(testing::ReadText(NominalRobotMjcfPath())), expected(NominalRobotMjcf(testing::SourcePath("robot")));
+  std::string file_line, expected_line;
+  for (int line = 1; std::getline(expected, expected_line); ++line) {
+    ASSERT_TRUE(std::getline(file, file_line) && file_line == expected_line)
+        << "robot/mjcf/trimbot.xml is out of date (run trimbot_robot_mjcf robot/): line " << line << " should be\n"
+        << expected_line;
+  }
+  EXPECT_FALSE(std::getline(file, file_line)) << "robot/mjcf/trimbot.xml goes on after its end: " << file_line;
+}
+
+// A run's world includes its robot (robot.xml beside world.xml: the run's start pose and
+// calibration) and adds the garden only.
+TEST(RobotMjcf, TheWorldIncludesTheRunsRobot) {
+  SimulatorConfig config = TestConfig(TestLawn(), "robot_mjcf");
+  config.start = {1.0, -2.0, 0.4};
+  Simulator simulator(config);
+  const std::string robot_xml = testing::ReadText(config.world_dir + "/robot.xml");
+  EXPECT_EQ(robot_xml, ComposeRobot(simulator.robot(), simulator.rig(), {config.start}).xml);
+  const std::string world_xml = testing::ReadText(config.world_dir + "/world.xml");
+  EXPECT_NE(world_xml.find("<include file=\"robot.xml\"/>"), std::string::npos);
+  for (const char* robot_part : {"<body", "<actuator", "<sensor", "<camera", "class=\"robot\""}) {
+    EXPECT_EQ(world_xml.find(robot_part), std::string::npos) << robot_part;
+  }
+  char error[1024] = "";
+  mjModel* robot = mj_loadXML((config.world_dir + "/robot.xml").c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(robot, nullptr) << error;
+  const mjModel* world = simulator.world().model();
+  EXPECT_EQ(world->nbody, robot->nbody);
+  EXPECT_EQ(world->nq, robot->nq);
+  EXPECT_EQ(world->nu, robot->nu);
+  EXPECT_EQ(world->nsensor, robot->nsensor);
+  EXPECT_EQ(world->ncam, robot->ncam);
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(world->qpos0[i], robot->qpos0[i]) << i;  // the start pose
+  mj_deleteModel(robot);
 }
 
 }  // namespace

@@ -385,7 +385,7 @@ std::vector<ArmContact> Simulator::ArmContacts() const {
   const World& world = *impl_->world;
   const mjModel* m = world.model();
   const mjData* d = world.data();
-  constexpr int kArmBit = 4;  // the arm_collision class's contype (world_builder)
+  constexpr int kArmBit = 4;  // the arm_collision class's contype (robot_mjcf)
   std::vector<ArmContact> contacts;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& contact = d->contact[i];

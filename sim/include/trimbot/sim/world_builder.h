@@ -1,7 +1,8 @@
 #pragma once
-// Composes the MuJoCo world (MJCF) from the robot description (URDF), the camera calibration and
-// a garden. The MJCF is written next to the run's outputs (world/world.xml with its textures), so
-// any run's world can be opened and inspected in MuJoCo's viewer.
+// Composes the MuJoCo world (MJCF) of a run: the garden, and the robot (robot_mjcf: from the robot
+// description (URDF) and the camera calibration) at its start pose. The MJCF is written next to the
+// run's outputs (world/world.xml, which includes world/robot.xml, with its textures), so any run's
+// world can be opened and inspected in MuJoCo's viewer.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -10,12 +11,9 @@
 #include "trimbot/garden/garden.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
+#include "trimbot/sim/robot_mjcf.h"
 
 namespace trimbot::sim {
-
-struct Pose2D {
-  double x = 0.0, y = 0.0, yaw = 0.0;
-};
 
 // $TRIMBOT_TEXTURE_CACHE if set, else trimbot_texture_cache in the system's temporary folder.
 std::string DefaultTextureCacheDir();
@@ -33,17 +31,8 @@ struct WorldOptions {
   std::string texture_cache_dir = DefaultTextureCacheDir();
 };
 
-// What the label images report for a geom.
-struct GeomLabel {
-  std::string geom_name;
-  garden::ObjectClass object_class = garden::ObjectClass::kNone;
-  std::uint16_t object_id = 0;
-  bool is_ground = false;
-  garden::Surface surface = garden::Surface::kGrass;  // meaningful when is_ground
-};
-
 struct WorldSpec {
-  std::string mjcf_path;           // world.xml written to disk
+  std::string mjcf_path;           // world.xml written to disk (robot.xml beside it)
   std::vector<GeomLabel> labels;   // every named geom that can appear in a label image
   std::vector<std::string> camera_names;  // MuJoCo camera i renders rig camera i
 };
