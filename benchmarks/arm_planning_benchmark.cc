@@ -95,16 +95,19 @@ void BM_PlanAroundABush(benchmark::State& state, arm::ArmPlannerParameters::Algo
   state.counters["success"] = static_cast<double>(succeeded) / static_cast<double>(seconds.size());
 }
 BENCHMARK_CAPTURE(BM_PlanAroundABush, rrt_connect, arm::ArmPlannerParameters::Algorithm::kRrtConnect)
-    ->Iterations(60)->Unit(benchmark::kMillisecond);
+    ->Iterations(60)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_PlanAroundABush, lazy_prm, arm::ArmPlannerParameters::Algorithm::kLazyPrm)
-    ->Iterations(60)->Unit(benchmark::kMillisecond);
+    ->Iterations(60)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_InverseKinematics(benchmark::State& state) {
   Setup& s = Shared();
   size_t next = 0;
   double solutions = 0.0;
   for (auto _ : state) {
-    const arm::IkResult result = s.kinematics.InverseKinematics(s.goals[next++ % s.goals.size()], s.parameters.planner.ik);
+    const arm::IkResult result =
+        s.kinematics.InverseKinematics(s.goals[next++ % s.goals.size()], s.parameters.planner.ik);
     solutions += static_cast<double>(result.solutions.size());
   }
   state.counters["solutions"] = solutions / static_cast<double>(state.iterations());

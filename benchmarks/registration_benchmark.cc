@@ -1,17 +1,16 @@
 // Registration time per pair: DUGMA and the baselines through the same API (Open3D's ICP,
-// point-to-plane ICP and generalized ICP), on the same synthetic garden clouds of 1k-64k points (20 deg, 0.5 m from the identity
-// guess), with the errors as counters; and DUGMA on the Kinect pairs of the DUGMA data set when it
-// is there (TRIMBOT_DUGMA_DATA, default ../shared/data/dugma_kinect beside the source tree).
+// point-to-plane ICP and generalized ICP), on the same synthetic garden clouds of 1k-64k points (20 deg, 0.5 m from the
+// identity guess), with the errors as counters; and DUGMA on the Kinect pairs of the DUGMA data set when it is there
+// (TRIMBOT_DUGMA_DATA, default ../shared/data/dugma_kinect beside the source tree).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
 #include <map>
 
-#include "evaluation/registration_pair_file.h"
 #include "evaluation/pose_errors.h"
+#include "evaluation/registration_pair_file.h"
 #include "synthetic_clouds.h"
 #include "trimbot/perception/registration.h"
-
 
 namespace {
 
@@ -55,19 +54,35 @@ void BM_Register(benchmark::State& state, RegistrationMethod method) {
   state.counters["iterations"] = result.iterations;
 }
 BENCHMARK_CAPTURE(BM_Register, dugma, RegistrationMethod::kDugma)
-    ->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond);
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Arg(16000)
+    ->Arg(64000)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Register, icp, RegistrationMethod::kIcpPointToPoint)
-    ->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond);
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Arg(16000)
+    ->Arg(64000)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Register, icp_plane, RegistrationMethod::kIcpPointToPlane)
-    ->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond);
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Arg(16000)
+    ->Arg(64000)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Register, generalized_icp, RegistrationMethod::kGeneralizedIcp)
-    ->Arg(1000)->Arg(4000)->Arg(16000)->Arg(64000)->Unit(benchmark::kMillisecond);
-
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Arg(16000)
+    ->Arg(64000)
+    ->Unit(benchmark::kMillisecond);
 
 // The Kinect pairs, one benchmark per pair, registered from the identity as in the data set.
 void RegisterKinectPairs() {
   const char* env = std::getenv("TRIMBOT_DUGMA_DATA");
-  const std::filesystem::path folder = env ? env : std::filesystem::path(TRIMBOT_SOURCE_DIR) / "../shared/data/dugma_kinect";
+  const std::filesystem::path folder =
+      env ? env : std::filesystem::path(TRIMBOT_SOURCE_DIR) / "../shared/data/dugma_kinect";
   if (!std::filesystem::is_directory(folder)) return;
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(folder)) files.push_back(entry.path().string());

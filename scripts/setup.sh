@@ -14,7 +14,7 @@ PACKAGES=(
   liborocos-kdl-dev libfcl-dev liboctomap-dev
   libompl-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
-  clang libclang-rt-dev
+  clang clang-format libclang-rt-dev
   slurmctld slurmd slurm-client munge
 )
 

@@ -62,7 +62,7 @@ TEST(CollisionModel, AllowedPairsAreTheUrdfsAdjacentLinks) {
   EXPECT_TRUE(has(model.checked_pairs(), "arm_link_4", "arm_link_6"));
   EXPECT_TRUE(has(model.checked_pairs(), "cutter_blade_link", "base_link"));
   EXPECT_FALSE(has(model.checked_pairs(), "base_link", "camera_ring_link"));  // neither moves
-  EXPECT_EQ(model.moving_links().size(), 7u);  // six arm links and the cutter
+  EXPECT_EQ(model.moving_links().size(), 7u);                                 // six arm links and the cutter
 }
 
 TEST(CollisionModel, HomeIsFreeAndNoCheckedPairTouchesEverywhere) {
@@ -83,7 +83,10 @@ TEST(CollisionModel, HomeIsFreeAndNoCheckedPairTouchesEverywhere) {
   int free = 0;
   for (int n = 0; n < 2000; ++n) {
     const CollisionReport report = model.Check(configurations.Next(), self_only);
-    if (report.collision) ++contacts[report.pair]; else ++free;
+    if (report.collision)
+      ++contacts[report.pair];
+    else
+      ++free;
   }
   for (const auto& [pair, count] : contacts) EXPECT_LT(count, 1500) << pair.first << " - " << pair.second;
   EXPECT_GT(free, 200);  // a folded arm hits the ring or base often, but far from always

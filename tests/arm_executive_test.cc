@@ -73,7 +73,8 @@ TEST(ArmExecutive, ReachesGoalsAroundWhatItSawAndRefusesOneInsideTheBush) {
   executive.SetPerceivedPoints(seen, {});
   EXPECT_FALSE(executive.WantsEnvironment());
   EXPECT_GT(executive.perceived_cells(), 500);
-  const auto home = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml")).arm_home_position;
+  const auto home =
+      robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml")).arm_home_position;
   Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(home.data(), 6), target = q;
   std::vector<ArmGoalResult> results;
   const double dt = 0.01, lag = 0.1;  // s: the follower closes on its target with this time constant

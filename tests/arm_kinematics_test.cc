@@ -66,8 +66,9 @@ TEST(ArmKinematics, ForwardKinematicsMatchesMujocoOverAThousandConfigurations) {
       const int body = mj_name2id(m, mjOBJ_BODY, arm.links()[k].c_str());
       const int site = mj_name2id(m, mjOBJ_SITE, arm.links()[k].c_str());
       if (body < 0 && site < 0) continue;
-      const Eigen::Isometry3d mujoco = T_base_world * (body >= 0 ? Pose(d->xpos + 3 * body, d->xmat + 9 * body)
-                                                                 : Pose(d->site_xpos + 3 * site, d->site_xmat + 9 * site));
+      const Eigen::Isometry3d mujoco =
+          T_base_world * (body >= 0 ? Pose(d->xpos + 3 * body, d->xmat + 9 * body)
+                                    : Pose(d->site_xpos + 3 * site, d->site_xmat + 9 * site));
       worst_position = std::max(worst_position, (mujoco.translation() - poses[k].translation()).norm());
       worst_angle = std::max(worst_angle, Eigen::AngleAxisd(mujoco.linear().transpose() * poses[k].linear()).angle());
       ++compared;
@@ -118,7 +119,6 @@ TEST(ArmKinematics, LimitsComeFromTheUrdf) {
   EXPECT_FALSE(arm.WithinLimits(q));
   EXPECT_THROW(arm.EndEffectorPose(Eigen::VectorXd::Zero(5)), std::invalid_argument);
 }
-
 
 // Poses the arm reaches (forward kinematics of random joint positions within the limits): IK finds
 // a solution for nearly all, each solution puts the cutter at the pose, and the branch the pose

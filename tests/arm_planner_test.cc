@@ -45,7 +45,8 @@ std::vector<Eigen::VectorXd> TargetsNearTheBush(const Fixture& f, int count) {
       q(i) = limit.continuous ? -M_PI + 2.0 * M_PI * uniform() : limit.lower + (limit.upper - limit.lower) * uniform();
     }
     const Eigen::Vector3d cutter = f.kinematics.EndEffectorPose(q).translation();
-    const double to_bush = (cutter - Eigen::Vector3d(1.25, 0.0, 0.45)).cwiseQuotient(Eigen::Vector3d(0.3, 0.3, 0.35)).norm();
+    const double to_bush =
+        (cutter - Eigen::Vector3d(1.25, 0.0, 0.45)).cwiseQuotient(Eigen::Vector3d(0.3, 0.3, 0.35)).norm();
     if (to_bush < 1.6 && !f.collision.Check(q).collision) targets.push_back(q);
   }
   return targets;
@@ -58,7 +59,8 @@ void ExpectFreeAndWithinLimits(const Fixture& f, const ArmPlan& plan, double vel
   for (size_t k = 0; k < t.positions.size(); ++k) {
     ASSERT_FALSE(f.collision.Check(t.positions[k]).collision) << "sample " << k;
     for (int i = 0; i < 6; ++i) {
-      EXPECT_LE(std::abs(t.velocities[k](i)), velocity_scale * f.kinematics.limits()[static_cast<size_t>(i)].velocity + 1e-9);
+      EXPECT_LE(std::abs(t.velocities[k](i)),
+                velocity_scale * f.kinematics.limits()[static_cast<size_t>(i)].velocity + 1e-9);
     }
     EXPECT_TRUE(f.kinematics.WithinLimits(t.positions[k]));
   }
@@ -108,7 +110,9 @@ TEST(ArmPlanner, PosesItCannotReachFailWithTheReason) {
       q(i) = limit.continuous ? -M_PI + 2.0 * M_PI * u : limit.lower + (limit.upper - limit.lower) * u;
     }
     inside = f.kinematics.EndEffectorPose(q);
-    found = (inside.translation() - Eigen::Vector3d(1.25, 0.0, 0.45)).cwiseQuotient(Eigen::Vector3d(0.3, 0.3, 0.35)).norm() < 0.8;
+    found = (inside.translation() - Eigen::Vector3d(1.25, 0.0, 0.45))
+                .cwiseQuotient(Eigen::Vector3d(0.3, 0.3, 0.35))
+                .norm() < 0.8;
   }
   const ArmPlan blocked = planner.PlanToPose(f.home, inside);
   EXPECT_FALSE(blocked.ok);

@@ -52,7 +52,7 @@ inline std::string Describe(const NodePath& path) {
 }
 
 inline void CollectLeaves(const YAML::Node& node, NodePath& path, const std::function<bool(const NodePath&)>& wanted,
-                   std::vector<NodePath>* scalars, std::vector<NodePath>* maps) {
+                          std::vector<NodePath>* scalars, std::vector<NodePath>* maps) {
   if (node.IsMap()) {
     if (wanted(path)) maps->push_back(path);
     for (const auto& entry : node) {
@@ -87,7 +87,8 @@ inline std::string Emit(const YAML::Node& root) {
 }
 
 // Every scalar replaced by values no key accepts, and every map given an unknown key.
-inline std::vector<BadInput> MutateYaml(const std::string& good_text, const std::function<bool(const NodePath&)>& wanted) {
+inline std::vector<BadInput> MutateYaml(const std::string& good_text,
+                                        const std::function<bool(const NodePath&)>& wanted) {
   const YAML::Node good = YAML::Load(good_text);
   std::vector<NodePath> scalars, maps;
   NodePath path;
@@ -126,7 +127,8 @@ inline std::string ReadFile(const std::string& path) {
 // The good file the cases were made from must load: otherwise every case would be refused for
 // the good file's fault and the test would prove nothing.
 inline int ExpectAllRefused(const std::string& kind, const std::string& good, const std::vector<BadInput>& cases,
-                     const std::function<void(const std::string&)>& load, const std::string& extension = ".yaml") {
+                            const std::function<void(const std::string&)>& load,
+                            const std::string& extension = ".yaml") {
   const std::string dir = TempDir("bad_input_" + kind);
   const std::string good_path = dir + "/good" + extension;
   std::ofstream(good_path) << good;

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "bad_input_corpus.h"
 #include "loop/drive_plan.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
-#include "bad_input_corpus.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/garden/garden_tools.h"
@@ -81,7 +81,8 @@ void LoadScenario(const std::string& path) {
 TEST(BadInput, ScenarioValuesAreCheckedAndNamed) {
   // Free text is free; every other value is checked.
   const auto wanted = [](const NodePath& p) { return p.empty() || (p[0].key != "name" && p[0].key != "description"); };
-  const int cases = ExpectAllRefused("scenario", kKitchenSinkScenario, MutateYaml(kKitchenSinkScenario, wanted), LoadScenario);
+  const int cases =
+      ExpectAllRefused("scenario", kKitchenSinkScenario, MutateYaml(kKitchenSinkScenario, wanted), LoadScenario);
   std::cout << "scenario: " << cases << " malformed inputs refused\n";
 }
 
@@ -94,14 +95,16 @@ TEST(BadInput, StackParametersAreCheckedAndNamed) {
 
 TEST(BadInput, DrivePlanAndMapAreCheckedAndNamed) {
   const std::string plan = ReadFile(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
-  int cases = ExpectAllRefused("drive_plan", plan, MutateYaml(plan, kEverything), [](const std::string& path) { DrivePlan::Load(path); });
+  int cases = ExpectAllRefused("drive_plan", plan, MutateYaml(plan, kEverything),
+                               [](const std::string& path) { DrivePlan::Load(path); });
   const std::string map_dir = testing::TempDir("bad_input_map_image");
   garden::OccupancyMap map;
   map.occupied = cv::Mat::zeros(10, 20, CV_8U);
   map.resolution = 0.1;
   map.origin = Eigen::Vector2d::Zero();
   garden::WriteOccupancyMap(map, map_dir, "map");
-  const std::string map_yaml = "image: " + map_dir + "/map.png\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+  const std::string map_yaml = "image: " + map_dir +
+                               "/map.png\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
                                "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
   const auto not_image = [](const NodePath& p) { return p.empty() || p[0].key != "image"; };
   cases += ExpectAllRefused("occupancy", map_yaml, MutateYaml(map_yaml, not_image),
@@ -135,7 +138,8 @@ TEST(BadInput, RelationsAndRangesAreChecked) {
       {"duplicate key", with("seed: 1", "seed: 1\nseed: 2"), "seed"},
       {"map resolution 1e308", with("resolution: 0.05", "resolution: 1.0e308"), "resolution"},
       {"time of day 25 h", with("time_of_day: 11.0", "time_of_day: 25"), "time_of_day"},
-      {"stack key unknown", with("stack: {localization: simulated_pose_fixes}", "stack: {localisation: none}"), "localisation"},
+      {"stack key unknown", with("stack: {localization: simulated_pose_fixes}", "stack: {localisation: none}"),
+       "localisation"},
   };
   int cases = ExpectAllRefused("relations_scenario", base, scenarios, LoadScenario);
 
@@ -157,7 +161,9 @@ TEST(BadInput, GardenUiCsvIsCheckedAndNamed) {
       {"below the ground", header + "2,Hedge-Ivy,box,0.76,6.432,0.5,9.693,0.429,-3.0,0\n", "below the ground"},
       {"no objects", header, "no objects"},
   };
-  ExpectAllRefused("gardenui", header + good, cases, [](const std::string& path) { garden::ImportGardenUiCsv(path, -1.48); }, ".csv");
+  ExpectAllRefused(
+      "gardenui", header + good, cases, [](const std::string& path) { garden::ImportGardenUiCsv(path, -1.48); },
+      ".csv");
 }
 
 }  // namespace

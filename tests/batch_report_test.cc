@@ -10,13 +10,13 @@
 #include <limits>
 #include <sstream>
 
+#include "evaluation/trial_evaluator.h"
+#include "evaluation/trial_result.h"
 #include "reports/batch_report.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
-#include "evaluation/trial_evaluator.h"
-#include "evaluation/trial_result.h"
 #include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {
@@ -415,8 +415,8 @@ TEST(LocalizationTiming, StatsPerStageAndTheHistogram) {
   for (int i = 1; i <= 10; ++i) frames.push_back({0.010 * i, 0.001, 0.002 * i, 0.0005});
   const nlohmann::json stats = LocalizationTimeStats(frames);
   EXPECT_EQ(stats["frames"].get<int>(), 10);
-  EXPECT_NEAR(stats["features"]["median_ms"].get<double>(), 55.0, 1e-9);   // between 50 and 60
-  EXPECT_NEAR(stats["features"]["p90_ms"].get<double>(), 91.0, 1e-9);      // 90 + 0.1 * 10
+  EXPECT_NEAR(stats["features"]["median_ms"].get<double>(), 55.0, 1e-9);           // between 50 and 60
+  EXPECT_NEAR(stats["features"]["p90_ms"].get<double>(), 91.0, 1e-9);              // 90 + 0.1 * 10
   EXPECT_NEAR(stats["total"]["median_ms"].get<double>(), 12.0 * 5.5 + 1.5, 1e-9);  // frame i: 12 i + 1.5 ms
   EXPECT_NEAR(stats["total"]["max_ms"].get<double>(), 121.5, 1e-9);
   const auto back = LocalizationTimesFromJson(stats);
@@ -477,7 +477,6 @@ TEST(RunTiming, StagesAccountForTheWallTimeAndAddUpOverTrials) {
   EXPECT_FALSE(cv::imread(png).empty());
   EXPECT_NE(FormatRunTiming(run).find("render_draw"), std::string::npos);
 }
-
 
 // Clearance is measured with the base's outline at the true pose against the garden as it is:
 // positive before an obstacle, negative as deep as the outline reaches into it.

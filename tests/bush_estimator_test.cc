@@ -23,8 +23,8 @@ PointCloud NearSide(const BushShape& shape, const Eigen::Vector2d& centre, doubl
       const Eigen::Vector3d local(a * std::sin(theta) * std::cos(phi), b * std::sin(theta) * std::sin(phi),
                                   c * std::cos(theta));
       const double cy = std::cos(shape.yaw), sy = std::sin(shape.yaw);
-      const Eigen::Vector3d p(centre.x() + cy * local.x() - sy * local.y(), centre.y() + sy * local.x() + cy * local.y(),
-                              shape.base_height + c + local.z());
+      const Eigen::Vector3d p(centre.x() + cy * local.x() - sy * local.y(),
+                              centre.y() + sy * local.x() + cy * local.y(), shape.base_height + c + local.z());
       if (p.head<2>().norm() > centre.norm()) continue;  // the far side is hidden (roughly)
       cloud.Add(p, Eigen::Matrix3d::Identity() * 1e-6);
     }
@@ -64,12 +64,13 @@ TEST(BushFit, FindsACylinderAndABox) {
           local = {0.35 * std::cos(2 * M_PI * t), 0.3 * std::sin(2 * M_PI * t)};
         } else {  // walk the box's outline
           const double s = 4.0 * t;
-          local = s < 1 ? Eigen::Vector2d(-0.35 + 0.7 * s, -0.3)
+          local = s < 1   ? Eigen::Vector2d(-0.35 + 0.7 * s, -0.3)
                   : s < 2 ? Eigen::Vector2d(0.35, -0.3 + 0.6 * (s - 1))
                   : s < 3 ? Eigen::Vector2d(0.35 - 0.7 * (s - 2), 0.3)
                           : Eigen::Vector2d(-0.35, 0.3 - 0.6 * (s - 3));
         }
-        const Eigen::Vector2d p = truth + Eigen::Vector2d(cy * local.x() - sy * local.y(), sy * local.x() + cy * local.y());
+        const Eigen::Vector2d p =
+            truth + Eigen::Vector2d(cy * local.x() - sy * local.y(), sy * local.x() + cy * local.y());
         if (p.norm() > truth.norm()) continue;
         cloud.Add({p.x(), p.y(), z}, Eigen::Matrix3d::Identity() * 1e-6);
       }
@@ -87,8 +88,8 @@ TEST(BushFit, SaysWhyWhenNothingIsThere) {
 }
 
 // Rendered: the robot drives at a bush from 3.3 m to 0.9 m (ring centre to bush centre); the front
-// pair's cloud is fitted every 0.4 s. The rose has grown since the survey (growth 0.7). The expected centre handed to the fit is 12 cm off (a map
-// or localization error), the bush's yaw as the survey gives it.
+// pair's cloud is fitted every 0.4 s. The rose has grown since the survey (growth 0.7). The expected centre handed to
+// the fit is 12 cm off (a map or localization error), the bush's yaw as the survey gives it.
 struct Approach {
   const char* name;
   BushShape shape;
@@ -106,8 +107,8 @@ TEST(RenderedBush, EstimatesWithinBoundsAlongTheApproach) {
     const Approach& b = bushes[i];
     objects += "  - {id: " + std::to_string(i + 1) + ", class: " + (i == 0 ? "topiary" : "rose") +
                ", shape: " + (i == 0 ? "ellipsoid" : "cylinder") + ", size: [" + std::to_string(b.shape.size.x()) +
-               ", " + std::to_string(b.shape.size.y()) + ", " + std::to_string(b.shape.size.z()) +
-               "], position: [" + std::to_string(b.position.x()) + ", " + std::to_string(b.position.y()) +
+               ", " + std::to_string(b.shape.size.y()) + ", " + std::to_string(b.shape.size.z()) + "], position: [" +
+               std::to_string(b.position.x()) + ", " + std::to_string(b.position.y()) +
                "], yaw_deg: " + std::to_string(b.shape.yaw * 180.0 / M_PI) + "}\n";
   }
   // A neighbour 1.3 m beside the topiary.
@@ -125,7 +126,8 @@ TEST(RenderedBush, EstimatesWithinBoundsAlongTheApproach) {
     const RingStereo stereo(simulator.rig(), StereoOptions{});
     const StereoRectifier& front = stereo.rectifiers()[0];
     messages::RingRequest request;
-    request.cameras = {std::min(front.pair().left, front.pair().right), std::max(front.pair().left, front.pair().right)};
+    request.cameras = {std::min(front.pair().left, front.pair().right),
+                       std::max(front.pair().left, front.pair().right)};
     simulator.SetBaseCommand({0.25, 0.0});
     sim::SensorOutputs sensors;
     sim::GroundTruth truth;
@@ -145,7 +147,8 @@ TEST(RenderedBush, EstimatesWithinBoundsAlongTheApproach) {
       BushShape shape = bush.shape;
       shape.yaw -= std::atan2(truth.T_map_base.linear()(1, 0), truth.T_map_base.linear()(0, 0));
       std::string why;
-      const auto estimate = FitBush(result.cloud, *ground, shape, centre.head<2>() + Eigen::Vector2d(0.1, 0.07), {}, &why);
+      const auto estimate =
+          FitBush(result.cloud, *ground, shape, centre.head<2>() + Eigen::Vector2d(0.1, 0.07), {}, &why);
       ASSERT_TRUE(estimate.has_value()) << bush.name << " at " << distance << " m: " << why;
       const Eigen::Vector2d estimated = estimate->centre - ring.head<2>();
       const double distance_error = estimated.norm() - distance;
@@ -159,7 +162,8 @@ TEST(RenderedBush, EstimatesWithinBoundsAlongTheApproach) {
       const bool grown = bush.growth > 0.0;
       const double bound = distance <= 1.3 ? (grown ? 0.02 : 0.0126) : distance <= 2.2 ? (grown ? 0.06 : 0.05) : 0.15;
       EXPECT_LT(std::abs(distance_error), bound) << bush.name << " at " << distance << " m";
-      EXPECT_LT(std::abs(bearing_error), (distance <= 1.3 ? 1.0 : 3.0) * M_PI / 180.0) << bush.name << " at " << distance;
+      EXPECT_LT(std::abs(bearing_error), (distance <= 1.3 ? 1.0 : 3.0) * M_PI / 180.0)
+          << bush.name << " at " << distance;
     }
   }
 }

@@ -87,7 +87,8 @@ TEST_F(RenderedTargets, TargetsLandWhereTheCalibrationProjectsThem) {
   EXPECT_EQ(checked, 7);
   std::printf("projection: worst target error %.3f px over %d targets\n", worst, checked);
   // Off-axis targets test the distortion: they are far from the principal point.
-  const Eigen::Vector2d corner_target = camera.Project(T_map_camera(0).inverse() * TargetCentre(simulator_->garden(), 17));
+  const Eigen::Vector2d corner_target =
+      camera.Project(T_map_camera(0).inverse() * TargetCentre(simulator_->garden(), 17));
   EXPECT_GT((corner_target - Eigen::Vector2d(camera.cx, camera.cy)).norm(), 250.0);
 }
 
@@ -270,7 +271,8 @@ TEST(FrustumCulling, DrawsTheSameImagesWithFewerGeoms) {
     EXPECT_EQ(timings[1].geoms_drawn + timings[1].geoms_culled, timings[0].geoms_drawn);
     ASSERT_EQ(captures[0].frame.images.size(), captures[1].frame.images.size());
     for (std::size_t i = 0; i < captures[0].frame.images.size(); ++i) {
-      EXPECT_TRUE(captures[0].frame.images[i].data == captures[1].frame.images[i].data) << "camera " << i << " yaw " << yaw;
+      EXPECT_TRUE(captures[0].frame.images[i].data == captures[1].frame.images[i].data)
+          << "camera " << i << " yaw " << yaw;
       const RenderedView& off = captures[0].truth.views[i];
       const RenderedView& on = captures[1].truth.views[i];
       EXPECT_EQ(cv::norm(off.object_id, on.object_id, cv::NORM_INF), 0.0) << "camera " << i << " yaw " << yaw;
@@ -284,9 +286,10 @@ TEST(FrustumCulling, DrawsTheSameImagesWithFewerGeoms) {
 // enough, the ground shadowed itself in stripes ("acne") where the shadow map's texels spanned
 // more depth than the slab.
 TEST(GroundShadows, GroundWithNothingOnItDoesNotShadowItself) {
-  const std::string garden = testing::WriteTempFile(
-      "bare_path.yaml", "name: bare_path\nseed: 4\nsize: [24, 24]\nground: grass\n"
-                        "paths:\n  - {surface: gravel, centre: [6.0, 0.0], size: [10.0, 1.2]}\nobjects: []\n");
+  const std::string garden =
+      testing::WriteTempFile("bare_path.yaml",
+                             "name: bare_path\nseed: 4\nsize: [24, 24]\nground: grass\n"
+                             "paths:\n  - {surface: gravel, centre: [6.0, 0.0], size: [10.0, 1.2]}\nobjects: []\n");
   for (const double hour : {12.0, 18.0}) {
     cv::Mat images[2];
     for (const bool shadows : {false, true}) {
@@ -343,10 +346,9 @@ TEST(GroundAppearance, SiftFindsFeaturesOnEveryGroundType) {
     std::size_t fewest = SIZE_MAX;
     for (const int seed : {-1, 1, 2, 3}) {  // -1: no seed in the file (derived from the name)
       const std::string seed_line = seed < 0 ? "" : "seed: " + std::to_string(seed) + "\n";
-      const std::string garden =
-          testing::WriteTempFile(std::string("ground_") + surface + ".yaml",
-                                 std::string("name: ground_") + surface + "\n" + seed_line + "size: [30, 30]\nground: " +
-                                     surface + "\nobjects: []\n");
+      const std::string garden = testing::WriteTempFile(std::string("ground_") + surface + ".yaml",
+                                                        std::string("name: ground_") + surface + "\n" + seed_line +
+                                                            "size: [30, 30]\nground: " + surface + "\nobjects: []\n");
       SimulatorConfig config = TestConfig(garden, std::string("sift_") + surface, true);
       Simulator simulator(config);
       const RingCapture capture = simulator.CaptureRing(false);

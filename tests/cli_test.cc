@@ -56,8 +56,9 @@ TEST(DriveCommand, ShortDriveWritesFramesLogsAndSummary) {
 // Options for a drive of a plan written to a temporary file.
 DriveOptions PlanFile(const std::string& name, const std::string& garden, const std::string& duration) {
   DriveOptions options;
-  options.plan_path = testing::WriteTempFile(name, "garden: " + garden + "\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\n" +
-                                                       "segments:\n  - {duration: " + duration + ", linear: 0, angular: 0}\n");
+  options.plan_path =
+      testing::WriteTempFile(name, "garden: " + garden + "\nseed: 1\nstart: {x: 0, y: 0, yaw_deg: 0}\n" +
+                                       "segments:\n  - {duration: " + duration + ", linear: 0, angular: 0}\n");
   options.output_dir = testing::TempDir(name);
   options.paths = {TRIMBOT_SOURCE_DIR};
   return options;

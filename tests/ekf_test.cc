@@ -17,7 +17,7 @@ namespace {
 
 const robot::DiffDriveGeometry kGeometry{0.115, 0.46};
 constexpr int kTicksPerRevolution = 2048;
-constexpr double kImuPeriod = 0.005;  // 200 Hz
+constexpr double kImuPeriod = 0.005;    // 200 Hz
 constexpr int kImuSamplesPerTicks = 4;  // wheel ticks at 50 Hz
 constexpr double kGyroBias = 0.01;      // rad/s
 constexpr double kGyroNoise = 0.005;    // rad/s
@@ -71,9 +71,9 @@ class SimulatedBase {
     fix.x = pose_.x + position_sigma * unit(rng_);
     fix.y = pose_.y + position_sigma * unit(rng_);
     fix.yaw = WrapAngle(pose_.yaw + yaw_sigma * unit(rng_));
-    fix.covariance = Eigen::Vector3d(position_sigma * position_sigma, position_sigma * position_sigma,
-                                     yaw_sigma * yaw_sigma)
-                         .asDiagonal();
+    fix.covariance =
+        Eigen::Vector3d(position_sigma * position_sigma, position_sigma * position_sigma, yaw_sigma * yaw_sigma)
+            .asDiagonal();
     return fix;
   }
 
@@ -105,9 +105,9 @@ void StepSensors(SimulatedBase* base, int i, Ekf* ekf) {
 
 Ekf MakeEkf(const Pose2& start = {}, double start_sigma = 0.01) {
   Ekf ekf(EkfParameters{}, kGeometry, kTicksPerRevolution);
-  ekf.Initialize(0.0, start, Eigen::Vector3d(start_sigma * start_sigma, start_sigma * start_sigma,
-                                             start_sigma * start_sigma)
-                                 .asDiagonal());
+  ekf.Initialize(
+      0.0, start,
+      Eigen::Vector3d(start_sigma * start_sigma, start_sigma * start_sigma, start_sigma * start_sigma).asDiagonal());
   return ekf;
 }
 
@@ -154,11 +154,12 @@ TEST(Ekf, FollowsAnArcOnWheelsAndGyro) {
   const double linear_rms = std::sqrt(linear_error_squares / speed_samples);
   const double angular_mean = angular_error_sum / speed_samples;
   const double angular_rms = std::sqrt(angular_error_squares / speed_samples);
-  std::printf("dead reckoning over 30 s: worst position error %.4f m, worst yaw error %.3f deg, "
-              "bias estimate %.5f rad/s; last 10 s: v error mean %.4f rms %.4f m/s, w error mean %.4f "
-              "rms %.4f rad/s\n",
-              worst_position, worst_yaw * 180.0 / M_PI, ekf.Estimate().gyro_bias, linear_mean, linear_rms,
-              angular_mean, angular_rms);
+  std::printf(
+      "dead reckoning over 30 s: worst position error %.4f m, worst yaw error %.3f deg, "
+      "bias estimate %.5f rad/s; last 10 s: v error mean %.4f rms %.4f m/s, w error mean %.4f "
+      "rms %.4f rad/s\n",
+      worst_position, worst_yaw * 180.0 / M_PI, ekf.Estimate().gyro_bias, linear_mean, linear_rms, angular_mean,
+      angular_rms);
   EXPECT_DOUBLE_EQ(ekf.Estimate().stamp, 30.0);
   EXPECT_LT(worst_position, 0.05);
   EXPECT_LT(worst_yaw, 2.0 * M_PI / 180.0);
@@ -189,10 +190,11 @@ TEST(Ekf, GyroBiasConvergesWithLateFixes) {
     }
   }
   const PoseEstimate estimate = ekf.Estimate();
-  std::printf("with fixes, last 60 s: worst position error %.4f m, worst yaw error %.3f deg; "
-              "bias %.5f rad/s (true %.3f), bias sigma %.5f; %d fixes rejected\n",
-              worst_position, worst_yaw * 180.0 / M_PI, estimate.gyro_bias, kGyroBias,
-              std::sqrt(ekf.covariance()(5, 5)), ekf.counters().fixes_rejected);
+  std::printf(
+      "with fixes, last 60 s: worst position error %.4f m, worst yaw error %.3f deg; "
+      "bias %.5f rad/s (true %.3f), bias sigma %.5f; %d fixes rejected\n",
+      worst_position, worst_yaw * 180.0 / M_PI, estimate.gyro_bias, kGyroBias, std::sqrt(ekf.covariance()(5, 5)),
+      ekf.counters().fixes_rejected);
   EXPECT_NEAR(estimate.gyro_bias, kGyroBias, 0.002);
   EXPECT_LT(worst_position, 0.03);
   EXPECT_LT(worst_yaw, 1.0 * M_PI / 180.0);
@@ -321,7 +323,7 @@ TEST(Ekf, FixOlderThanTheHistoryIsTooOld) {
   SimulatedBase base = ArcDrive(6);
   Ekf ekf = MakeEkf();
   int step = 0;
-  WarmUp(&base, &ekf, &step);  // 2 s
+  WarmUp(&base, &ekf, &step);                                   // 2 s
   for (; step <= 1000; ++step) StepSensors(&base, step, &ekf);  // 5 s
   messages::PoseFix fix = base.Fix(0.02, 0.01);
   fix.stamp = ekf.Estimate().stamp - EkfParameters{}.history_seconds - 0.01;

@@ -60,12 +60,14 @@ TEST(Garden, BadFilesNameTheFileLineAndKey) {
   ExpectGardenError("unknown_class.yaml",
                     head + "objects:\n  - {id: 1, class: bush, shape: box, size: [1, 1, 1], position: [0, 0]}\n",
                     "line 5: key 'objects[0].class': unknown object class 'bush'");
-  ExpectGardenError("unknown_key.yaml",
-                    head + "objects:\n  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [0, 0], colour: red}\n",
-                    "unknown key 'objects[0].colour'");
+  ExpectGardenError(
+      "unknown_key.yaml",
+      head + "objects:\n  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [0, 0], colour: red}\n",
+      "unknown key 'objects[0].colour'");
   ExpectGardenError("duplicate.yaml",
-                    head + "objects:\n  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [0, 0]}\n"
-                           "  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [2, 0]}\n",
+                    head +
+                        "objects:\n  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [0, 0]}\n"
+                        "  - {id: 1, class: rose, shape: box, size: [1, 1, 1], position: [2, 0]}\n",
                     "duplicate id 1");
   ExpectGardenError("negative.yaml",
                     head + "objects:\n  - {id: 1, class: rose, shape: box, size: [1, -1, 1], position: [0, 0]}\n",
@@ -169,12 +171,12 @@ TEST(WageningenGarden, HasEveryObjectOfTheMapInItsPlace) {
   std::string line;
   int rows = 0;
   const std::map<std::string, ObjectClass> classes = {
-      {"Hedge-Ivy", ObjectClass::kHedge},       {"Hedge-Box", ObjectClass::kHedge},
+      {"Hedge-Ivy", ObjectClass::kHedge},         {"Hedge-Box", ObjectClass::kHedge},
       {"Topiary-Generic", ObjectClass::kTopiary}, {"Topiary-Ellipsoid", ObjectClass::kTopiary},
-      {"Rose-Generic", ObjectClass::kRose},     {"Obstacle-Tree", ObjectClass::kTree},
-      {"Obstacle-Trunk", ObjectClass::kTrunk},  {"Obstacle-Fence", ObjectClass::kFence},
-      {"Obstacle-Post", ObjectClass::kFence},   {"Obstacle-Generic", ObjectClass::kObstacle},
-      {"Robot-Vehicle", ObjectClass::kObstacle}, {"Background-Generic", ObjectClass::kObstacle}};
+      {"Rose-Generic", ObjectClass::kRose},       {"Obstacle-Tree", ObjectClass::kTree},
+      {"Obstacle-Trunk", ObjectClass::kTrunk},    {"Obstacle-Fence", ObjectClass::kFence},
+      {"Obstacle-Post", ObjectClass::kFence},     {"Obstacle-Generic", ObjectClass::kObstacle},
+      {"Robot-Vehicle", ObjectClass::kObstacle},  {"Background-Generic", ObjectClass::kObstacle}};
   while (std::getline(csv, line)) {
     if (line.empty() || line[0] == '#' || line.rfind("id,", 0) == 0) continue;
     std::stringstream row(line);
@@ -299,9 +301,9 @@ TEST(FoliageMesh, TrimmedIsTheTargetShapeAndGrowthAddsIrregularly) {
     max_growth = std::max(max_growth, grown[i] - trimmed[i]);
     min_growth = std::min(min_growth, grown[i] - trimmed[i]);
   }
-  EXPECT_LT(max_deviation, 0.03);      // leaf clumps only: within 3 cm of the trimmed sphere
-  EXPECT_GT(max_deviation, 0.005);     // ... but not a smooth primitive
-  EXPECT_GT(mean_growth, 0.05);        // a season adds several cm on average
+  EXPECT_LT(max_deviation, 0.03);   // leaf clumps only: within 3 cm of the trimmed sphere
+  EXPECT_GT(max_deviation, 0.005);  // ... but not a smooth primitive
+  EXPECT_GT(mean_growth, 0.05);     // a season adds several cm on average
   EXPECT_LE(max_growth, kMaxGrowth * 1.6 + 1e-9);
   EXPECT_GT(max_growth - min_growth, 0.05);  // and unevenly (shoots)
 }

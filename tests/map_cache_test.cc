@@ -31,11 +31,13 @@ void Edit(const std::string& path, const std::string& from, const std::string& t
 class MapCacheKeyTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = testing::TempDir("map_cache_key_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    root_ = testing::TempDir("map_cache_key_" +
+                             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(root_);
     fs::create_directories(root_ + "/garden_scenes");
     fs::copy(testing::SourcePath("robot"), root_ + "/robot", fs::copy_options::recursive);
-    fs::copy(testing::SourcePath("garden_scenes/gardens"), root_ + "/garden_scenes/gardens", fs::copy_options::recursive);
+    fs::copy(testing::SourcePath("garden_scenes/gardens"), root_ + "/garden_scenes/gardens",
+             fs::copy_options::recursive);
     fs::copy(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"), root_ + "/plan.yaml");
     recipe_.plan_path = root_ + "/plan.yaml";
     recipe_.descriptor = visual_localization::Descriptor::kUprightSift;
@@ -62,25 +64,34 @@ TEST_F(MapCacheKeyTest, TheSameInputsGiveTheSameKey) {
 }
 
 TEST_F(MapCacheKeyTest, WhatTheMapDoesNotDependOnLeavesTheKey) {
-  EXPECT_FALSE(KeyChangesWith([&] { Edit(root_ + "/plan.yaml", "# Headless drive", "# A comment changed. Headless drive"); }));
-  EXPECT_FALSE(KeyChangesWith([&] { Edit(root_ + "/robot/config/stack.yaml", "cruise_speed: 0.25", "cruise_speed: 0.3"); }));
-  EXPECT_FALSE(KeyChangesWith([&] { Edit(root_ + "/garden_scenes/gardens/wageningen.yaml", "name: wageningen", "name: wageningen  # another garden"); }));
-  EXPECT_FALSE(KeyChangesWith([&] { fs::copy(root_ + "/plan.yaml", root_ + "/elsewhere.yaml"); recipe_.plan_path = root_ + "/elsewhere.yaml"; }))
-      << "the plan's content counts, not its path";
+  EXPECT_FALSE(
+      KeyChangesWith([&] { Edit(root_ + "/plan.yaml", "# Headless drive", "# A comment changed. Headless drive"); }));
+  EXPECT_FALSE(
+      KeyChangesWith([&] { Edit(root_ + "/robot/config/stack.yaml", "cruise_speed: 0.25", "cruise_speed: 0.3"); }));
+  EXPECT_FALSE(KeyChangesWith([&] {
+    Edit(root_ + "/garden_scenes/gardens/wageningen.yaml", "name: wageningen", "name: wageningen  # another garden");
+  }));
+  EXPECT_FALSE(KeyChangesWith([&] {
+    fs::copy(root_ + "/plan.yaml", root_ + "/elsewhere.yaml");
+    recipe_.plan_path = root_ + "/elsewhere.yaml";
+  })) << "the plan's content counts, not its path";
 }
 
 TEST_F(MapCacheKeyTest, EveryInputOfTheMapChangesTheKey) {
   EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/plan.yaml", "seed: 1", "seed: 2"); }));
   SetUp();
-  EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/plan.yaml", "{duration: 16.8, linear: 0.25", "{duration: 16.9, linear: 0.25"); }));
+  EXPECT_TRUE(KeyChangesWith(
+      [&] { Edit(root_ + "/plan.yaml", "{duration: 16.8, linear: 0.25", "{duration: 16.9, linear: 0.25"); }));
   SetUp();
-  EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/garden_scenes/gardens/test_lawn.yaml", "position: [3.0, 1.2]", "position: [3.1, 1.2]"); }));
+  EXPECT_TRUE(KeyChangesWith(
+      [&] { Edit(root_ + "/garden_scenes/gardens/test_lawn.yaml", "position: [3.0, 1.2]", "position: [3.1, 1.2]"); }));
   SetUp();
   EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/robot/calibration/nominal_camchain.yaml", "540.0", "541.0"); }));
   SetUp();
   EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/robot/urdf/trimbot.urdf", "<robot", "<!-- changed --><robot"); }));
   SetUp();
-  EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/robot/config/robot_parameters.yaml", "rate_hz: 200.0", "rate_hz: 100.0"); }));
+  EXPECT_TRUE(
+      KeyChangesWith([&] { Edit(root_ + "/robot/config/robot_parameters.yaml", "rate_hz: 200.0", "rate_hz: 100.0"); }));
   SetUp();
   EXPECT_TRUE(KeyChangesWith([&] { recipe_.descriptor = visual_localization::Descriptor::kSift; }));
   SetUp();
@@ -100,7 +111,8 @@ TEST_F(MapCacheKeyTest, AScenarioAsTheMappingDriveCountsTheStackParameters) {
   fs::copy(testing::SourcePath("scenarios/navigation/smoke.yaml"), root_ + "/scenario.yaml");
   recipe_.plan_path = root_ + "/scenario.yaml";
   key_ = MapCacheKey(recipe_, paths_);
-  EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/robot/config/stack.yaml", "cruise_speed: 0.25", "cruise_speed: 0.3"); }));
+  EXPECT_TRUE(
+      KeyChangesWith([&] { Edit(root_ + "/robot/config/stack.yaml", "cruise_speed: 0.25", "cruise_speed: 0.3"); }));
 }
 
 TEST_F(MapCacheKeyTest, ACachedMapIsFoundOnlyUnderItsOwnKey) {

@@ -4,14 +4,14 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <filesystem>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 
 #include "loop/closed_loop.h"
-#include "loop/pilots.h"
 #include "loop/drive_plan.h"
+#include "loop/pilots.h"
 #include "runners/localization_eval.h"
 #include "runners/mapping.h"
 #include "test_support.h"
@@ -78,8 +78,10 @@ TEST(VisualMap, RefusesCorruptAndForeignFilesNamingThem) {
     }
     return std::string("accepted");
   };
-  EXPECT_NE(message([&] { VisualMap::Load(good, "wageningen"); }).find("made in garden 'test_lawn'"), std::string::npos);
-  EXPECT_NE(message([&] { VisualMap::Load(good, "", "ffffffffffffffff"); }).find("another camera rig"), std::string::npos);
+  EXPECT_NE(message([&] { VisualMap::Load(good, "wageningen"); }).find("made in garden 'test_lawn'"),
+            std::string::npos);
+  EXPECT_NE(message([&] { VisualMap::Load(good, "", "ffffffffffffffff"); }).find("another camera rig"),
+            std::string::npos);
   EXPECT_NE(message([&] { VisualMap::Load(good, "", "", Descriptor::kSift); }).find("descriptor is upright_sift"),
             std::string::npos);
   const std::string garbage = testing::WriteTempFile("garbage.sqlite", "this is not a database at all");
@@ -115,7 +117,8 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
   EXPECT_GT(stats["mean_track_length"].get<double>(), 2.0);
   EXPECT_LT(stats["reprojection_rmse_px"].get<double>(), 3.0);
   const auto& errors = stats["keyframes_against_ground_truth"];
-  EXPECT_LT(errors["adjusted_position_error_mean_m"].get<double>(), errors["survey_position_error_mean_m"].get<double>())
+  EXPECT_LT(errors["adjusted_position_error_mean_m"].get<double>(),
+            errors["survey_position_error_mean_m"].get<double>())
       << "bundle adjustment brings the keyframes closer to the truth than the survey";
   const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   const VisualMap map = VisualMap::Load(options.out_dir + "/map.sqlite", "test_lawn", RigSignature(rig));
@@ -131,10 +134,12 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const std::string dir = testing::TempDir("map_for_queries");
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
   const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
-  const scenarios::DrivePlan plan = scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
+  const scenarios::DrivePlan plan =
+      scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
   scenarios::WorldSetup world = plan.world;
   world.seed = 77;
-  sim::SimulatorConfig config = scenarios::MakeSimulatorConfig({TRIMBOT_SOURCE_DIR}, world, testing::TempDir("map_query"));
+  sim::SimulatorConfig config =
+      scenarios::MakeSimulatorConfig({TRIMBOT_SOURCE_DIR}, world, testing::TempDir("map_query"));
   config.cameras_on_schedule = false;
   sim::Simulator simulator(config);
   scenarios::DrivePlanPlayer player(plan, 4.1);
@@ -150,20 +155,23 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
     if (retrieval == Retrieval::kPosePrior) options.cameras = {0, 2, 4, 6, 8};  // the left cameras alone
     VisualLocalizer localizer(VisualMap::Load(dir + "/map.sqlite", "test_lawn", RigSignature(rig)), rig, options);
     const std::optional<Eigen::Vector2d> prior =
-        retrieval == Retrieval::kVocabulary ? std::nullopt
-                                            : std::optional<Eigen::Vector2d>(truth.translation().head<2>() + Eigen::Vector2d(0.4, -0.3));
+        retrieval == Retrieval::kVocabulary
+            ? std::nullopt
+            : std::optional<Eigen::Vector2d>(truth.translation().head<2>() + Eigen::Vector2d(0.4, -0.3));
     const LocalizationResult result = localizer.Localize(capture.frame, prior);
     ASSERT_FALSE(result.retrieved.empty());
     const auto& best = localizer.map().keyframes[static_cast<std::size_t>(result.retrieved.front())];
     EXPECT_LT((best.T_map_base.translation() - truth.translation()).head<2>().norm(), 1.0);
     ASSERT_TRUE(result.success) << result.failure;
     const double position_error = (result.T_map_base.translation() - truth.translation()).head<2>().norm();
-    const double yaw_error = Eigen::AngleAxisd(result.T_map_base.linear().transpose() * truth.linear()).angle() * 180 / M_PI;
-    std::printf("localized with %d features, %d matches, %d inliers: %.1f cm, %.2f deg (%.0f ms features, %.0f ms "
-                "retrieval, %.0f ms matching, %.0f ms pose)\n",
-                result.features, result.matches, result.inliers, 100 * position_error, yaw_error,
-                1000 * result.timings.features, 1000 * result.timings.retrieval, 1000 * result.timings.matching,
-                1000 * result.timings.pose);
+    const double yaw_error =
+        Eigen::AngleAxisd(result.T_map_base.linear().transpose() * truth.linear()).angle() * 180 / M_PI;
+    std::printf(
+        "localized with %d features, %d matches, %d inliers: %.1f cm, %.2f deg (%.0f ms features, %.0f ms "
+        "retrieval, %.0f ms matching, %.0f ms pose)\n",
+        result.features, result.matches, result.inliers, 100 * position_error, yaw_error,
+        1000 * result.timings.features, 1000 * result.timings.retrieval, 1000 * result.timings.matching,
+        1000 * result.timings.pose);
     EXPECT_LT(position_error, 0.05);
     EXPECT_LT(yaw_error, 1.0);
     EXPECT_GT(result.planar_covariance(0, 0), 0.0);

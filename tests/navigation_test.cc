@@ -203,7 +203,8 @@ std::vector<NavigationEvent> DriveUntilDone(Navigator& navigator, Pose2& pose, O
 }
 
 int Count(const std::vector<NavigationEvent>& events, NavigationEvent::Type type) {
-  return static_cast<int>(std::count_if(events.begin(), events.end(), [type](const auto& e) { return e.type == type; }));
+  return static_cast<int>(
+      std::count_if(events.begin(), events.end(), [type](const auto& e) { return e.type == type; }));
 }
 
 // An obstacle the prior map lacks appears on the path (perception's costmap): the navigator plans
@@ -267,14 +268,13 @@ TEST(Navigator, GoalNearAnObstacleIsReachedAtTheNearestFeasiblePoint) {
   EXPECT_EQ(Count(refused, NavigationEvent::Type::kGoalAdjusted), 0);
 }
 
-
 // The bush servo on a kinematic base: from 1.5 m off, with measurements of the bush's centre
 // every 0.4 s (1 cm noise), it stops with the arm's axis at the standoff, the bush straight ahead.
 TEST(BushServo, DrivesTheArmToTheStandoffAndConfirmsStandingStill) {
   BushServoParameters parameters;
   const Eigen::Vector2d arm_axis(0.23, 0.0), bush(3.0, 1.0);
   BushServo servo(parameters, arm_axis);
-  Pose2 pose{1.6, 0.2, 0.3};  // the bush about 20 deg to the left
+  Pose2 pose{1.6, 0.2, 0.3};                              // the bush about 20 deg to the left
   servo.Expect(bush + Eigen::Vector2d(0.1, -0.1), 0.35);  // the map's belief, 14 cm off
   servo.Start(0.0);
   std::uint64_t state = 12345;

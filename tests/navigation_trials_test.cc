@@ -9,11 +9,11 @@
 #include <regex>
 #include <sstream>
 
-#include "runners/batch.h"
-#include "loop/scenario.h"
-#include "test_support.h"
 #include "loop/prior_knowledge.h"
+#include "loop/scenario.h"
+#include "runners/batch.h"
 #include "runners/trial.h"
+#include "test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden.h"
@@ -48,7 +48,8 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
     EXPECT_EQ(s.name, name);
     EXPECT_EQ(s.goals.size(), 4u);
     EXPECT_EQ(s.trials, 6);
-    EXPECT_NEAR((s.goals.back().position - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9) << "a loop";
+    EXPECT_NEAR((s.goals.back().position - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9)
+        << "a loop";
     ASSERT_TRUE(s.stack.has_value());
     EXPECT_EQ(StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).localization,
               stack::LocalizationSource::kSimulatedPoseFixes);
@@ -69,7 +70,8 @@ TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
     const Eigen::Vector2d goal = scenario_goal.position;
     EXPECT_GE(map.DistanceToObstacle(goal), radius) << "goal " << goal.transpose() << " is not reachable";
     double closest = 1e9;
-    for (double f = 0.0; f <= 1.0; f += 0.005) closest = std::min(closest, map.DistanceToObstacle(from + f * (goal - from)));
+    for (double f = 0.0; f <= 1.0; f += 0.005)
+      closest = std::min(closest, map.DistanceToObstacle(from + f * (goal - from)));
     EXPECT_LT(closest, radius) << "straight path from " << from.transpose() << " to " << goal.transpose();
     from = goal;
   }
@@ -127,7 +129,8 @@ TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   double worst_focal = 0.0, worst_angle = 0.0;
   for (int i = 0; i < truth.size(); ++i) {
     worst_focal = std::max(worst_focal, std::abs(read.camera(i).intrinsics.fx / truth.camera(i).intrinsics.fx - 1.0));
-    const Eigen::AngleAxisd delta(truth.camera(i).T_base_camera.linear().transpose() * read.camera(i).T_base_camera.linear());
+    const Eigen::AngleAxisd delta(truth.camera(i).T_base_camera.linear().transpose() *
+                                  read.camera(i).T_base_camera.linear());
     worst_angle = std::max(worst_angle, delta.angle() * 180.0 / M_PI);
   }
   EXPECT_GT(worst_focal, 0.001);
@@ -190,7 +193,8 @@ TEST(Planner, ReachesAGoalOnlySomeHeadingsCanArriveAt) {
   Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle.yaml"));
   const garden::OccupancyMap prior = PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
-  const stack::GlobalPlanner planner(map, stack::StackParameters::Load(testing::SourcePath("robot/config/stack.yaml")).navigation.planner);
+  const stack::GlobalPlanner planner(
+      map, stack::StackParameters::Load(testing::SourcePath("robot/config/stack.yaml")).navigation.planner);
   const Eigen::Vector2d start(0.29, -0.44), goal(0.49, 0.94);
   for (int run = 0; run < 12; ++run) {
     stack::SeedPlanner(static_cast<std::uint64_t>(run) + 1);  // the same 12 runs every time
@@ -236,7 +240,8 @@ TEST(Scenario, BadFilesNameTheFileLineAndKey) {
 TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
   const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
   const std::string out = testing::TempDir("trial_faults");
-  Scenario clean = Scenario::Load(SmokeVariant("fixes.yaml", "localization: none", "localization: simulated_pose_fixes"));
+  Scenario clean =
+      Scenario::Load(SmokeVariant("fixes.yaml", "localization: none", "localization: simulated_pose_fixes"));
   const TrialWorld world = PrepareTrialWorld(clean, paths);  // the faults change nothing of it
   WritePriorMap(world.prior_map, out + "/map");
 

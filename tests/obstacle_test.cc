@@ -123,7 +123,8 @@ class RenderedObstacle : public ::testing::Test {
     const perception::StereoRectifier& front = stereo.rectifiers()[0];
     ASSERT_EQ(front.pair().left, 0);
     messages::RingRequest request;
-    request.cameras = {std::min(front.pair().left, front.pair().right), std::max(front.pair().left, front.pair().right)};
+    request.cameras = {std::min(front.pair().left, front.pair().right),
+                       std::max(front.pair().left, front.pair().right)};
     for (int k = 0; k < frames; ++k) {
       const sim::RingCapture capture = simulator.CaptureRing(request, false);
       const auto result = stereo.ComputePair(capture.frame, 0);

@@ -57,7 +57,8 @@ TEST(BadInput, CamchainValuesAreCheckedAndNamed) {
   };
   const YAML::Node cam0 = YAML::Load(camchain)["cam0"];
   std::ostringstream resolution;
-  resolution << "resolution: [" << cam0["resolution"][0].as<std::string>() << ", " << cam0["resolution"][1].as<std::string>() << "]";
+  resolution << "resolution: [" << cam0["resolution"][0].as<std::string>() << ", "
+             << cam0["resolution"][1].as<std::string>() << "]";
   std::ostringstream intrinsics;
   intrinsics << "intrinsics: [" << cam0["intrinsics"][0].as<std::string>();
   const std::vector<BadInput> ranges = {
@@ -99,7 +100,8 @@ TEST(BadInput, RegistrationPairFilesAreCheckedAndNamed) {
       {"unknown covariance kind", "covariances furlongs\n" + PairText().substr(21), "covariances"},
       {"empty file", "", "ground truth"},
   };
-  ExpectAllRefused("pair", PairText(), cases, [](const std::string& path) { LoadRegistrationPair(path); }, ".txt");
+  ExpectAllRefused(
+      "pair", PairText(), cases, [](const std::string& path) { LoadRegistrationPair(path); }, ".txt");
 }
 
 }  // namespace

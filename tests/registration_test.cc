@@ -8,10 +8,10 @@
 #include <cmath>
 #include <random>
 
-#include "evaluation/registration_pair_file.h"
-#include "runners/registration_cv.h"
-#include "evaluation/registration_set.h"
 #include "evaluation/pose_errors.h"
+#include "evaluation/registration_pair_file.h"
+#include "evaluation/registration_set.h"
+#include "runners/registration_cv.h"
 #include "synthetic_clouds.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
@@ -73,9 +73,9 @@ TEST(Registration, BadPointsAreDroppedAndCountedNeverNaN) {
   PointCloud y = ObservedFrom(x, truth, 8);
   x.points[3] = Eigen::Vector3d(NAN, 0, 0);
   x.covariances[4](1, 1) = NAN;
-  x.covariances[5] = Eigen::Matrix3d::Zero();               // singular
+  x.covariances[5] = Eigen::Matrix3d::Zero();                 // singular
   x.covariances[6] = Eigen::Vector3d(1, -1, 1).asDiagonal();  // not positive definite
-  y.covariances[0] = 1e6 * Eigen::Matrix3d::Identity();     // above max_variance: unusable
+  y.covariances[0] = 1e6 * Eigen::Matrix3d::Identity();       // above max_variance: unusable
   const RegistrationResult r = Register(x, y, Eigen::Isometry3d::Identity());
   EXPECT_EQ(r.target_points.non_finite, 2);
   EXPECT_EQ(r.target_points.unusable_covariance, 2);
@@ -116,7 +116,8 @@ TEST(RegistrationPairFile, ReadsTheDataSetFormatAndNamesBadLines) {
   EXPECT_EQ(pair.y.size(), 1u);
   EXPECT_NEAR(pair.truth.translation().x(), 0.5, 1e-12);
   EXPECT_TRUE(std::isnan(pair.x.covariances[1](0, 0)));
-  const std::string bad = testing::WriteTempFile("pair_bad.txt", "R 1 0 0 0 1 0 0 0 1\nt 0 0 0\nX 1\n0 0 zero 1 0 0 1 0 1\n");
+  const std::string bad =
+      testing::WriteTempFile("pair_bad.txt", "R 1 0 0 0 1 0 0 0 1\nt 0 0 0\nX 1\n0 0 zero 1 0 0 1 0 1\n");
   try {
     scenarios::LoadRegistrationPair(bad);
     FAIL() << "expected an InputError";
@@ -174,7 +175,8 @@ namespace {
 std::vector<scenarios::RegistrationPair> RenderedPairs(int count, const std::string& folder) {
   scenarios::RegistrationSetOptions options;
   options.pairs = count;
-  return scenarios::RenderRegistrationPairs(options, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR}, testing::TempDir(folder));
+  return scenarios::RenderRegistrationPairs(options, scenarios::ProjectPaths{TRIMBOT_SOURCE_DIR},
+                                            testing::TempDir(folder));
 }
 
 }  // namespace

@@ -7,8 +7,8 @@
 
 #include "evaluation/comparison.h"
 #include "evaluation/statistics.h"
-#include "runners/batch.h"
 #include "loop/scenario.h"
+#include "runners/batch.h"
 #include "runners/sweep.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
@@ -55,8 +55,8 @@ TEST(Statistics, PowerGrowsWithTrialsAndTheDrop) {
 
 TEST(Overrides, SetNestedKeysAndAreCheckedLikeTheFile) {
   const std::string smoke = testing::SourcePath("scenarios/navigation/smoke.yaml");
-  const Scenario s = Scenario::Load(
-      smoke, ParseOverrides({"trials=3", "stack.navigation.follower.cruise_speed=0.3", "initial_pose_sigma.yaw_deg=1"}));
+  const Scenario s = Scenario::Load(smoke, ParseOverrides({"trials=3", "stack.navigation.follower.cruise_speed=0.3",
+                                                           "initial_pose_sigma.yaw_deg=1"}));
   EXPECT_EQ(s.trials, 3);
   EXPECT_NEAR(s.initial_yaw_sigma, M_PI / 180.0, 1e-12);
   ASSERT_TRUE(s.stack.has_value());
@@ -102,7 +102,8 @@ TEST(Compare, FlagsARealRegressionAndNotOtherSeeds) {
   const json reseeded = RunSmoke("reseeded", 101, {});
   const json slower = RunSmoke("slower", 1, {"stack.navigation.follower.cruise_speed=0.15"});
   EXPECT_EQ(baseline["overrides"].size(), 0u);
-  EXPECT_EQ(slower["overrides"][0], "stack.navigation.follower.cruise_speed=0.15") << "the result says what produced it";
+  EXPECT_EQ(slower["overrides"][0], "stack.navigation.follower.cruise_speed=0.15")
+      << "the result says what produced it";
   const Comparison same = CompareBatches(baseline, "baseline", reseeded, "reseeded");
   EXPECT_FALSE(same.regressed) << ToMarkdown(same);
   const Comparison worse = CompareBatches(baseline, "baseline", slower, "slower");

@@ -174,7 +174,8 @@ TEST(BadInput, MissingAndMalformedUrdf) {
   ExpectInputError([] { RobotDescription::Load("/nonexistent/robot.urdf"); }, "/nonexistent/robot.urdf", "not found");
   const std::string broken = testing::WriteTempFile("broken.urdf", "<robot name='x'><link name='base_link'>");
   ExpectInputError([&] { RobotDescription::Load(broken); }, broken, "malformed URDF");
-  const std::string no_camera = testing::WriteTempFile("no_camera.urdf", "<robot name='x'><link name='base_link'/></robot>");
+  const std::string no_camera =
+      testing::WriteTempFile("no_camera.urdf", "<robot name='x'><link name='base_link'/></robot>");
   ExpectInputError([&] { RobotDescription::Load(no_camera); }, no_camera, "missing link");
 }
 
@@ -186,14 +187,17 @@ TEST(BadInput, MalformedCalibration) {
       "cam0:\n  camera_model: pinhole\n  distortion_model: radtan\n  distortion_coeffs: [0, 0, 0, 0]\n"
       "  resolution: [752, 480]\n";
   const std::string no_intrinsics = testing::WriteTempFile("no_intrinsics.yaml", header);
-  ExpectInputError([&] { CameraRig::LoadKalibr(no_intrinsics, identity); }, no_intrinsics, "'cam0.intrinsics': missing");
+  ExpectInputError([&] { CameraRig::LoadKalibr(no_intrinsics, identity); }, no_intrinsics,
+                   "'cam0.intrinsics': missing");
   const std::string bad_type = testing::WriteTempFile("bad_type.yaml", header + "  intrinsics: [540, 540, abc, 240]\n");
   ExpectInputError([&] { CameraRig::LoadKalibr(bad_type, identity); }, bad_type, "expected a list of numbers");
-  const std::string unknown = testing::WriteTempFile("unknown.yaml", header + "  intrinsics: [540, 540, 376, 240]\n  focal: 3\n");
+  const std::string unknown =
+      testing::WriteTempFile("unknown.yaml", header + "  intrinsics: [540, 540, 376, 240]\n  focal: 3\n");
   ExpectInputError([&] { CameraRig::LoadKalibr(unknown, identity); }, unknown, "unknown key 'cam0.focal'");
   const std::string not_rigid = testing::WriteTempFile(
-      "not_rigid.yaml", header + "  intrinsics: [540, 540, 376, 240]\ncam1:\n  T_cn_cnm1: [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n" +
-                            header.substr(6) + "  intrinsics: [540, 540, 376, 240]\n");
+      "not_rigid.yaml",
+      header + "  intrinsics: [540, 540, 376, 240]\ncam1:\n  T_cn_cnm1: [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n" +
+          header.substr(6) + "  intrinsics: [540, 540, 376, 240]\n");
   ExpectInputError([&] { CameraRig::LoadKalibr(not_rigid, identity); }, not_rigid, "not a rigid transform");
   const std::string broken = testing::WriteTempFile("broken_yaml.yaml", "cam0: [unclosed\n");
   ExpectInputError([&] { CameraRig::LoadKalibr(broken, identity); }, broken, "malformed YAML");

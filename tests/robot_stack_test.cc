@@ -28,8 +28,7 @@ robot::RobotFiles Files() { return robot::RobotFiles::InFolder(SourcePath("robot
 // encoder counts at 50 Hz and a gyro + accelerometer at 200 Hz.
 class UnicyclePlant {
  public:
-  explicit UnicyclePlant(Pose2 start)
-      : pose_(start), geometry_(robot::RobotDescription::Load(Files().urdf).drive()) {}
+  explicit UnicyclePlant(Pose2 start) : pose_(start), geometry_(robot::RobotDescription::Load(Files().urdf).drive()) {}
 
   // Advances by dt = 5 ms at the commanded speeds; feeds the stack what is due.
   void Step(RobotStack& stack, double linear, double angular) {
@@ -49,7 +48,8 @@ class UnicyclePlant {
     stack.Add(imu);
     if (step_ % 4 == 0) {
       constexpr double kTicksPerRadian = 2048.0 / (2.0 * M_PI);
-      stack.Add(messages::WheelTicks{t_, std::llround(left_ * kTicksPerRadian), std::llround(right_ * kTicksPerRadian)});
+      stack.Add(
+          messages::WheelTicks{t_, std::llround(left_ * kTicksPerRadian), std::llround(right_ * kTicksPerRadian)});
     }
   }
   const Pose2& pose() const { return pose_; }
@@ -89,7 +89,8 @@ std::string WriteMap() {
   const double resolution = 0.05;
   cv::Mat image(160, 240, CV_8U, cv::Scalar(254));  // free
   // Map origin (-2, -4); the block spans x 3.5..4.5, y -0.5..0.5.
-  const int column = static_cast<int>((3.5 + 2.0) / resolution), row_top = static_cast<int>(160 - (0.5 + 4.0) / resolution);
+  const int column = static_cast<int>((3.5 + 2.0) / resolution),
+            row_top = static_cast<int>(160 - (0.5 + 4.0) / resolution);
   image(cv::Rect(column, row_top, 20, 20)).setTo(0);
   cv::imwrite(dir + "/map.png", image);
   std::ofstream(dir + "/map.yaml") << "image: map.png\nresolution: 0.05\norigin: [-2.0, -4.0, 0.0]\nnegate: 0\n"
@@ -171,8 +172,8 @@ std::string Variant(const std::string& name, const std::string& pattern, const s
   std::ifstream in(Files().stack_parameters);
   std::stringstream text;
   text << in.rdbuf();
-  const std::string changed = std::regex_replace(text.str(), std::regex(pattern), replacement,
-                                                 std::regex_constants::format_first_only);
+  const std::string changed =
+      std::regex_replace(text.str(), std::regex(pattern), replacement, std::regex_constants::format_first_only);
   EXPECT_NE(changed, text.str()) << pattern;
   return testing::WriteTempFile(name, changed);
 }
@@ -188,8 +189,10 @@ TEST(StackParameters, BadFilesNameTheFileAndTheKey) {
       {"missing.yaml", "  gyro_sigma: [^\n]*\n", "", "key 'ekf.gyro_sigma': missing"},
       {"unknown.yaml", "  gyro_sigma:", "  gyro_sigmaa: 0.005\n  gyro_sigma:", "key 'ekf.gyro_sigmaa'"},
       {"nan.yaml", "gyro_sigma: 0.005", "gyro_sigma: .nan", "key 'ekf.gyro_sigma': must be a finite number"},
-      {"inf.yaml", "cruise_speed: 0.25", "cruise_speed: .inf", "key 'navigation.follower.cruise_speed': must be a finite"},
-      {"range.yaml", "cruise_speed: 0.25", "cruise_speed: 2.0", "key 'navigation.follower.cruise_speed': must be in [0.01, 0.6]"},
+      {"inf.yaml", "cruise_speed: 0.25", "cruise_speed: .inf",
+       "key 'navigation.follower.cruise_speed': must be a finite"},
+      {"range.yaml", "cruise_speed: 0.25", "cruise_speed: 2.0",
+       "key 'navigation.follower.cruise_speed': must be in [0.01, 0.6]"},
       {"negative.yaml", "iterations: 3000", "iterations: -5", "key 'navigation.planner.iterations': must be in"},
       {"source.yaml", "localization: visual", "localization: gps", "unknown source 'gps'"},
       {"type.yaml", "enabled: false", "enabled: maybe", "key 'perception.local_fusion.enabled': expected a boolean"},
@@ -210,7 +213,8 @@ TEST(StackParameters, BadFilesNameTheFileAndTheKey) {
 TEST(StackParameters, OverridesReplaceOnlyTheKeysGiven) {
   const StackParameters defaults = StackParameters::Load(Files().stack_parameters);
   const std::string path = testing::WriteTempFile(
-      "overrides.yaml", "stack:\n  localization: simulated_pose_fixes\n  navigation: {follower: {cruise_speed: 0.3}}\n");
+      "overrides.yaml",
+      "stack:\n  localization: simulated_pose_fixes\n  navigation: {follower: {cruise_speed: 0.3}}\n");
   const YamlMap root = YamlMap::LoadFile(path);
   const StackParameters p = defaults.Overridden(root.Map("stack"));
   EXPECT_EQ(p.localization, LocalizationSource::kSimulatedPoseFixes);

@@ -155,19 +155,19 @@ TEST(AutoExposure, BringsTheGroundToTheTargetByExposureThenGain) {
   ae.max_exposure_factor = 2.0;
   ae.max_gain = 4.0;
   const ReadNoise noiseless(1, 16);
-  cv::Mat image(100, 50, CV_8UC3, cv::Scalar(200, 200, 200));            // sky
-  image.rowRange(50, 100).setTo(cv::Scalar(20, 30, 40));                 // ground, mean 30
+  cv::Mat image(100, 50, CV_8UC3, cv::Scalar(200, 200, 200));  // sky
+  image.rowRange(50, 100).setTo(cv::Scalar(20, 30, 40));       // ground, mean 30
   const ExposureResult dark = MeterExposure(image, ae);
   EXPECT_NEAR(dark.exposure_factor, 2.0, 1e-9);
   EXPECT_NEAR(dark.gain, 100.0 / 30.0 / 2.0, 1e-9);
   noiseless.ReadOut(image, dark.exposure_factor * dark.gain, 0.0, 0);
   const cv::Scalar ground = cv::mean(image.rowRange(50, 100));
   EXPECT_NEAR((ground[0] + ground[1] + ground[2]) / 3.0, 100.0, 1.0);
-  EXPECT_EQ(image.at<cv::Vec3b>(0, 0)[0], 255);                          // the sky saturates
+  EXPECT_EQ(image.at<cv::Vec3b>(0, 0)[0], 255);  // the sky saturates
 
   cv::Mat bright(100, 50, CV_8UC3, cv::Scalar(220, 220, 220));
   const ExposureResult shorter = MeterExposure(bright, ae);
-  EXPECT_NEAR(shorter.exposure_factor, 0.5, 1e-9);                       // limited at 1/2
+  EXPECT_NEAR(shorter.exposure_factor, 0.5, 1e-9);  // limited at 1/2
   EXPECT_EQ(shorter.gain, 1.0);
   noiseless.ReadOut(bright, shorter.exposure_factor * shorter.gain, 0.0, 0);
   EXPECT_EQ(bright.at<cv::Vec3b>(99, 0)[0], 110);

@@ -23,8 +23,7 @@ struct PlanarPose {
 };
 
 PlanarPose Planar(const Eigen::Isometry3d& pose) {
-  return {pose.translation().x(), pose.translation().y(),
-          std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))};
+  return {pose.translation().x(), pose.translation().y(), std::atan2(pose.linear()(1, 0), pose.linear()(0, 0))};
 }
 
 // Drives a constant command and integrates the unicycle model with the same rate-limited
@@ -58,7 +57,8 @@ void DriveAndCompareWithArc(double linear, double angular, double seconds, doubl
     worst_heading = std::max(worst_heading, std::abs(std::remainder(actual.yaw - expected.yaw, 2 * M_PI)));
   }
   const PlanarPose end = Planar(simulator.ground_truth().T_map_base);
-  EXPECT_LT(worst, tolerance) << "end at " << end.x << ", " << end.y << " expected " << expected.x << ", " << expected.y;
+  EXPECT_LT(worst, tolerance) << "end at " << end.x << ", " << end.y << " expected " << expected.x << ", "
+                              << expected.y;
   EXPECT_LT(worst_heading, 0.02);
   // The robot stays on the ground and upright.
   EXPECT_NEAR(simulator.ground_truth().T_map_base.translation().z(), 0.0, 0.01);
@@ -165,7 +165,8 @@ TEST(MujocoModel, AgreesWithTheUrdf) {
     // The joint axis in the world matches the URDF axis carried by the child frame.
     const Eigen::Isometry3d child = T_map_base * simulator.robot().FramePose(joint->child_link_name);
     const Eigen::Vector3d axis = child.linear() * Eigen::Vector3d(joint->axis.x, joint->axis.y, joint->axis.z);
-    EXPECT_LT((Eigen::Vector3d(d->xaxis[3 * id], d->xaxis[3 * id + 1], d->xaxis[3 * id + 2]) - axis).norm(), 1e-6) << name;
+    EXPECT_LT((Eigen::Vector3d(d->xaxis[3 * id], d->xaxis[3 * id + 1], d->xaxis[3 * id + 2]) - axis).norm(), 1e-6)
+        << name;
     if (joint->type == urdf::Joint::REVOLUTE) {
       EXPECT_NEAR(m->jnt_range[2 * id], joint->limits->lower, 1e-9) << name;
       EXPECT_NEAR(m->jnt_range[2 * id + 1], joint->limits->upper, 1e-9) << name;
@@ -210,8 +211,10 @@ TEST(Arm, ServosReachAPositionTargetAgainstGravity) {
   }
   // The end effector is where the URDF puts it for these joint angles.
   std::map<std::string, double> joints;
-  for (size_t i = 0; i < command.position.size(); ++i) joints[robot::RobotFrames::ArmJoint(static_cast<int>(i))] = truth.arm_position[i];
-  const Eigen::Vector3d expected = (truth.T_map_base * simulator.robot().FramePose("arm_end_effector", joints)).translation();
+  for (size_t i = 0; i < command.position.size(); ++i)
+    joints[robot::RobotFrames::ArmJoint(static_cast<int>(i))] = truth.arm_position[i];
+  const Eigen::Vector3d expected =
+      (truth.T_map_base * simulator.robot().FramePose("arm_end_effector", joints)).translation();
   EXPECT_LT((truth.T_map_end_effector.translation() - expected).norm(), 0.01);
 }
 
@@ -268,7 +271,8 @@ TEST(World, TheGardensLookDoesNotDependOnTheRunSeed) {
   EXPECT_EQ(FileBytes(a.world_dir + "/world.xml"), world_b);
   const garden::Garden lawn = garden::Garden::Load(TestLawn());
   EXPECT_EQ(lawn.appearance_seed, garden::Garden::Load(TestLawn()).appearance_seed);
-  EXPECT_NE(lawn.appearance_seed, garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml")).appearance_seed);
+  EXPECT_NE(lawn.appearance_seed,
+            garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml")).appearance_seed);
 }
 
 }  // namespace
@@ -328,7 +332,8 @@ TEST(RobotMjcf, LoadsOnItsOwn) {
   const int site = mj_name2id(m, mjOBJ_SITE, robot::RobotFrames::kImu);
   ASSERT_GE(site, 0);
   EXPECT_EQ(m->nsensor, 2);
-  for (const auto& [sensor, type] : {std::pair{"imu_accelerometer", mjSENS_ACCELEROMETER}, std::pair{"imu_gyro", mjSENS_GYRO}}) {
+  for (const auto& [sensor, type] :
+       {std::pair{"imu_accelerometer", mjSENS_ACCELEROMETER}, std::pair{"imu_gyro", mjSENS_GYRO}}) {
     const int id = mj_name2id(m, mjOBJ_SENSOR, sensor);
     ASSERT_GE(id, 0) << sensor;
     EXPECT_EQ(m->sensor_type[id], type) << sensor;
@@ -346,7 +351,8 @@ TEST(RobotMjcf, LoadsOnItsOwn) {
 // The checked-in file cannot go stale: it is what the URDF and the nominal calibration give
 // (after a change, trimbot_robot_mjcf robot/ rewrites it).
 TEST(RobotMjcf, IsWhatTheUrdfAndTheNominalCalibrationGive) {
-  std::istringstream file(testing::ReadText(NominalRobotMjcfPath())), expected(NominalRobotMjcf(testing::SourcePath("robot")));
+  std::istringstream file(testing::ReadText(NominalRobotMjcfPath())),
+      expected(NominalRobotMjcf(testing::SourcePath("robot")));
   std::string file_line, expected_line;
   for (int line = 1; std::getline(expected, expected_line); ++line) {
     ASSERT_TRUE(std::getline(file, file_line) && file_line == expected_line)

@@ -8,10 +8,10 @@
 #include <random>
 #include <vector>
 
+#include "evaluation/stereo_evaluation.h"
 #include "sim_test_support.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/stereo.h"
-#include "evaluation/stereo_evaluation.h"
 #include "trimbot/robot/robot_description.h"
 
 namespace trimbot::perception {
@@ -83,8 +83,8 @@ void CheckRectification(const robot::CameraRig& rig) {
           const Eigen::Vector3d in_left(x * depth, y * depth, depth);
           const Eigen::Vector2d pixel_left = left.intrinsics.Project(in_left);
           const Eigen::Vector2d pixel_right = right.intrinsics.Project(T_right_left * in_left);
-          const auto rectified = rectifier.Rectify(SpotImage(left.intrinsics, pixel_left),
-                                                   SpotImage(right.intrinsics, pixel_right));
+          const auto rectified =
+              rectifier.Rectify(SpotImage(left.intrinsics, pixel_left), SpotImage(right.intrinsics, pixel_right));
           const Eigen::Vector2d centre_left = SpotCentre(rectified.left);
           const Eigen::Vector2d centre_right = SpotCentre(rectified.right);
           const double z_rectified = (rectifier.R_rectified_left() * in_left).z();
@@ -106,8 +106,8 @@ void CheckRectification(const robot::CameraRig& rig) {
     }
   }
   EXPECT_EQ(checked, 5 * 27);
-  std::printf("rectification (%s): worst row difference %.3f px, worst disparity error %.3f px\n",
-              rig.source().c_str(), worst_row, worst_disparity);
+  std::printf("rectification (%s): worst row difference %.3f px, worst disparity error %.3f px\n", rig.source().c_str(),
+              worst_row, worst_disparity);
 }
 
 TEST(StereoRectifier, NominalRingPointsShareARowAtDisparityFocalTimesBaselineOverDepth) {
@@ -202,7 +202,7 @@ TEST(DisparityToCloud, KeepsDepthsInsideTheRangeAndSubsamples) {
   const StereoRectifier rectifier(rig, rig.StereoPairs()[0]);
   const double f_times_b = rectifier.focal_length() * rectifier.baseline();
   cv::Mat disparity(rectifier.image_size(), CV_32F, cv::Scalar(static_cast<float>(f_times_b / 3.0)));
-  disparity.colRange(0, 100).setTo(f_times_b / 20.0);  // beyond max_depth
+  disparity.colRange(0, 100).setTo(f_times_b / 20.0);   // beyond max_depth
   disparity.colRange(100, 200).setTo(f_times_b / 0.1);  // closer than min_depth
   StereoOptions options;
   options.stride = 4;
@@ -269,10 +269,11 @@ TEST_F(RenderedStereo, SgmDisparityMatchesGroundTruth) {
     const auto result = stereo.ComputePair(capture_->frame, 0);
     const cv::Mat truth = GroundTruthDisparity(stereo.rectifiers()[0], capture_->truth.views[0].depth);
     const StereoErrors errors = EvaluateDisparity(result.disparity, truth, options.EffectiveDisparities());
-    std::printf("pair 0, %d disparities: MAE %.3f px, bad-1 %.2f %%, bad-2 %.2f %%, completeness %.1f %% of %d px, "
-                "spurious %.2f %%\n",
-                options.EffectiveDisparities(), errors.mean_abs_error, errors.bad1_percent, errors.bad2_percent,
-                errors.completeness_percent, errors.ground_truth_pixels, errors.spurious_percent);
+    std::printf(
+        "pair 0, %d disparities: MAE %.3f px, bad-1 %.2f %%, bad-2 %.2f %%, completeness %.1f %% of %d px, "
+        "spurious %.2f %%\n",
+        options.EffectiveDisparities(), errors.mean_abs_error, errors.bad1_percent, errors.bad2_percent,
+        errors.completeness_percent, errors.ground_truth_pixels, errors.spurious_percent);
     SCOPED_TRACE(dense ? "dense" : "32 disparities");
     EXPECT_GT(errors.ground_truth_pixels, 150000);
     EXPECT_LT(errors.mean_abs_error, 0.35);
@@ -307,8 +308,8 @@ TEST_F(RenderedStereo, CloudDepthMatchesGroundTruth) {
   ASSERT_GT(relative_errors.size(), 100000u);
   const double median_relative = Median(relative_errors);
   const double median_normalized = Median(normalized_errors);
-  std::printf("cloud of pair 0: %zu points, median depth error %.2f %% of depth, %.2f sigma\n",
-              relative_errors.size(), 100.0 * median_relative, median_normalized);
+  std::printf("cloud of pair 0: %zu points, median depth error %.2f %% of depth, %.2f sigma\n", relative_errors.size(),
+              100.0 * median_relative, median_normalized);
   EXPECT_LT(median_relative, 0.03);  // measured 2.2 %
   // For Gaussian errors the median is 0.67 sigma: the stated uncertainty is neither too small
   // nor uselessly large.
@@ -394,5 +395,3 @@ TEST(StereoInput, WrongImageSizeNamesBothSizes) {
 
 }  // namespace
 }  // namespace trimbot::perception
-
-

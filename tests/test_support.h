@@ -5,7 +5,6 @@
 #include <sstream>
 #include <string>
 
-
 namespace trimbot::testing {
 
 inline std::string SourcePath(const std::string& relative) { return std::string(TRIMBOT_SOURCE_DIR) + "/" + relative; }

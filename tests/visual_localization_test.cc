@@ -28,8 +28,9 @@ TEST(RigPose, RecoversTheRingsPoseFromCorrespondencesWithOutliers) {
   const std::vector<Eigen::Isometry3d> T_base_camera = RingExtrinsics();
   ASSERT_EQ(T_base_camera.size(), 10u);
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
-  truth.linear() = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()))
-                       .toRotationMatrix();
+  truth.linear() =
+      (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   truth.translation() << 3.0, -2.0, 0.01;
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), depth(2.0, 12.0);
@@ -100,7 +101,8 @@ TEST(UprightSift, DescriptorsOfARotatedImageDifferOrdinarySiftsDoNot) {
                           static_cast<float>(rotation.at<double>(1, 0) * p.x + rotation.at<double>(1, 1) * p.y +
                                              rotation.at<double>(1, 2)));
       for (std::size_t j = 0; j < b.keypoints.size(); ++j) {
-        if (cv::norm(b.keypoints[j].pt - q) < 1.0 && std::abs(b.keypoints[j].size - a.keypoints[i].size) < 0.2f * a.keypoints[i].size) {
+        if (cv::norm(b.keypoints[j].pt - q) < 1.0 &&
+            std::abs(b.keypoints[j].size - a.keypoints[i].size) < 0.2f * a.keypoints[i].size) {
           distances.push_back(cv::norm(a.descriptors.row(static_cast<int>(i)), b.descriptors.row(static_cast<int>(j))));
           break;
         }

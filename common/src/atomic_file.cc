@@ -1,10 +1,10 @@
 #include "trimbot/common/atomic_file.h"
 
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace trimbot {
 

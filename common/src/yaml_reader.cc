@@ -74,13 +74,9 @@ int YamlMap::Int(const std::string& key) const { return As<int>(key, "integer");
 bool YamlMap::Bool(const std::string& key) const { return As<bool>(key, "boolean"); }
 std::string YamlMap::String(const std::string& key) const { return As<std::string>(key, "string"); }
 
-double YamlMap::Double(const std::string& key, double fallback) const {
-  return Has(key) ? Double(key) : fallback;
-}
+double YamlMap::Double(const std::string& key, double fallback) const { return Has(key) ? Double(key) : fallback; }
 int YamlMap::Int(const std::string& key, int fallback) const { return Has(key) ? Int(key) : fallback; }
-bool YamlMap::Bool(const std::string& key, bool fallback) const {
-  return Has(key) ? Bool(key) : fallback;
-}
+bool YamlMap::Bool(const std::string& key, bool fallback) const { return Has(key) ? Bool(key) : fallback; }
 std::string YamlMap::String(const std::string& key, const std::string& fallback) const {
   return Has(key) ? String(key) : fallback;
 }
@@ -121,8 +117,7 @@ std::vector<double> YamlMap::Doubles(const std::string& key, int expected_size) 
     if (!std::isfinite(out.back())) Fail(key, "must hold finite numbers, got '" + item.Scalar() + "'");
   }
   if (expected_size >= 0 && static_cast<int>(out.size()) != expected_size) {
-    Fail(key, "expected " + std::to_string(expected_size) + " numbers, got " +
-                  std::to_string(out.size()));
+    Fail(key, "expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(out.size()));
   }
   return out;
 }
@@ -155,7 +150,8 @@ std::vector<int> YamlMap::Integers(const std::string& key, int lo, int hi) const
 
 std::string YamlMap::Name(const std::string& key) const {
   const std::string name = String(key);
-  if (!IsPlainName(name)) Fail(key, "'" + name + "' is not a plain name (letters, digits, _ - . and not starting with .)");
+  if (!IsPlainName(name))
+    Fail(key, "'" + name + "' is not a plain name (letters, digits, _ - . and not starting with .)");
   return name;
 }
 
@@ -189,7 +185,8 @@ void YamlMap::RejectUnknownKeys() const {
     const std::string key = entry.first.as<std::string>();
     // yaml-cpp keeps one of two equal keys silently; a repeated key is a mistake in the file.
     if (!seen.insert(key).second) {
-      throw InputError(file_, LineOf(entry.first) + "key '" + (path_.empty() ? key : path_ + "." + key) + "' appears twice");
+      throw InputError(file_,
+                       LineOf(entry.first) + "key '" + (path_.empty() ? key : path_ + "." + key) + "' appears twice");
     }
     if (read_keys_.count(key) == 0) {
       const std::string full_key = path_.empty() ? key : path_ + "." + key;

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
-#include <sstream>
 #include <set>
+#include <sstream>
 
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
@@ -39,7 +39,8 @@ GardenObject ReadGardenObject(const YamlMap& item) {
   const auto object_class = ObjectClassFromString(class_name);
   if (!object_class || *object_class == ObjectClass::kNone || *object_class == ObjectClass::kGround ||
       *object_class == ObjectClass::kRobot) {
-    item.Fail("class", "unknown object class '" + class_name + "' (topiary, rose, hedge, tree, trunk, fence, obstacle)");
+    item.Fail("class",
+              "unknown object class '" + class_name + "' (topiary, rose, hedge, tree, trunk, fence, obstacle)");
   }
   object.object_class = *object_class;
   object.shape = ParseShape(item);
@@ -139,8 +140,8 @@ std::string Garden::ToYaml() const {
   out << "objects:" << (objects.empty() ? " []" : "") << "\n";
   for (const auto& o : objects) {
     out << "  - {id: " << o.id << ", class: " << ToString(o.object_class) << ", shape: " << shape_name(o.shape)
-        << ", size: [" << o.size.x() << ", " << o.size.y() << ", " << o.size.z() << "], position: ["
-        << o.position.x() << ", " << o.position.y() << "]";
+        << ", size: [" << o.size.x() << ", " << o.size.y() << ", " << o.size.z() << "], position: [" << o.position.x()
+        << ", " << o.position.y() << "]";
     if (o.base_height != 0.0) out << ", base_height: " << o.base_height;
     if (o.yaw != 0.0) out << ", yaw_deg: " << o.yaw / kDegToRad;
     out << "}\n";
@@ -152,7 +153,8 @@ void Garden::AddObjects(const std::vector<GardenObject>& extra) {
   for (const GardenObject& added : extra) {
     for (const GardenObject& object : objects) {
       if (object.id == added.id) {
-        throw std::invalid_argument("object id " + std::to_string(added.id) + " is already used in garden '" + name + "'");
+        throw std::invalid_argument("object id " + std::to_string(added.id) + " is already used in garden '" + name +
+                                    "'");
       }
     }
     objects.push_back(added);

@@ -5,10 +5,10 @@
 
 #include <cmath>
 #include <fstream>
-#include <set>
-#include <optional>
 #include <iomanip>
+#include <optional>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "trimbot/common/atomic_file.h"
@@ -79,7 +79,8 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
     std::stringstream row(line);
     for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
     if (fields.size() != 10) {
-      throw InputError(path, "line " + std::to_string(line_number) + ": expected 10 fields, got " + std::to_string(fields.size()));
+      throw InputError(
+          path, "line " + std::to_string(line_number) + ": expected 10 fields, got " + std::to_string(fields.size()));
     }
     GardenObject object;
     const auto fail = [&](const std::string& problem) {
@@ -106,15 +107,22 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
     object.base_height = number(8, "pos_z", -kMaxGardenExtent, kMaxGardenExtent) - ground_z;
     object.yaw = number(9, "yaw_deg", -360.0, 360.0) * kDegToRad;
     const auto object_class = ClassOfLabel(fields[1]);
-    if (!object_class) fail("unknown label '" + fields[1] + "' (Topiary-*, Hedge-*, Rose-*, Obstacle-*, Background-*, Robot-*)");
+    if (!object_class)
+      fail("unknown label '" + fields[1] + "' (Topiary-*, Hedge-*, Rose-*, Obstacle-*, Background-*, Robot-*)");
     object.object_class = *object_class;
     // GardenUI boxes are bounding boxes: topiary and tree crowns are round, roses and trunks cylinders.
     switch (object.object_class) {
       case ObjectClass::kTopiary:
-      case ObjectClass::kTree: object.shape = Shape::kEllipsoid; break;
+      case ObjectClass::kTree:
+        object.shape = Shape::kEllipsoid;
+        break;
       case ObjectClass::kRose:
-      case ObjectClass::kTrunk: object.shape = Shape::kCylinder; break;
-      default: object.shape = Shape::kBox; break;
+      case ObjectClass::kTrunk:
+        object.shape = Shape::kCylinder;
+        break;
+      default:
+        object.shape = Shape::kBox;
+        break;
     }
     // The boxes were fitted to point clouds whose lowest points lie above the ground (grass hides
     // the base): objects that start low stand on the ground, keeping their tops. Tree crowns stay up.
@@ -205,8 +213,9 @@ class GardenGenerator {
     for (int side = 0; side < 4; ++side) {
       const bool along_x = side < 2;
       const double offset = (side % 2 == 0 ? -1 : 1) * (along_x ? half_.y() : half_.x());
-      GardenObject fence = Make(ObjectClass::kFence, Shape::kBox,
-                                along_x ? Eigen::Vector3d(p_.size.x(), 0.1, 0.8) : Eigen::Vector3d(0.1, p_.size.y(), 0.8));
+      GardenObject fence =
+          Make(ObjectClass::kFence, Shape::kBox,
+               along_x ? Eigen::Vector3d(p_.size.x(), 0.1, 0.8) : Eigen::Vector3d(0.1, p_.size.y(), 0.8));
       fence.position = along_x ? Eigen::Vector2d(0.0, offset) : Eigen::Vector2d(offset, 0.0);
       fence.id = next_id_++;
       garden_.objects.push_back(fence);
@@ -238,7 +247,8 @@ class GardenGenerator {
                                 other.size.head<2>(), other.yaw, margin);
       }
       for (const auto& path : garden_.paths) {
-        free = free && !Overlap(object.position, object.size.head<2>(), object.yaw, path.centre, path.size, path.yaw, 0.1);
+        free =
+            free && !Overlap(object.position, object.size.head<2>(), object.yaw, path.centre, path.size, path.yaw, 0.1);
       }
       if (free) {
         object.id = next_id_++;
@@ -319,8 +329,7 @@ void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const st
   WriteFileAtomically(dir + "/" + name + ".yaml", yaml.str());
 }
 
-void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2,
-                         const std::string& path) {
+void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2, const std::string& path) {
   Rng rng = MakeRng(garden.appearance_seed, "ground_truth_ply");
   std::ostringstream body;
   body << std::setprecision(6);
@@ -351,8 +360,8 @@ void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_
     sample_mesh(ObjectMesh(object, garden.appearance_seed, growth), ObjectPose(object), object.object_class, object.id);
   }
   std::ostringstream ply;
-  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << garden.appearance_seed << " growth " << growth
-      << "\nelement vertex " << count
+  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << garden.appearance_seed << " growth "
+      << growth << "\nelement vertex " << count
       << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar class\nproperty ushort object\n"
          "end_header\n"
       << body.str();

@@ -88,7 +88,8 @@ Mesh SuperellipsoidMesh(const GardenObject& object, std::uint64_t seed, double c
     const double polar = M_PI * r / kRings;
     for (int s = 0; s <= kSegments; ++s) {
       const double azimuth = 2.0 * M_PI * s / kSegments;
-      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar));
+      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
+                              std::cos(polar));
       const Eigen::Vector3d surface = d * SuperRadius(d, half, n, m);
       const double clumps = ValueNoise(object_seed, surface / clump_scale) * 0.7 +
                             ValueNoise(object_seed + 1, surface / (clump_scale * 0.4)) * 0.3;
@@ -175,8 +176,8 @@ std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& 
   const int columns = std::max(1, static_cast<int>(std::ceil((max.x() - min.x()) / tile - 1e-9)));
   const int rows = std::max(1, static_cast<int>(std::ceil((max.y() - min.y()) / tile - 1e-9)));
   const auto pick = [&](const char* what, long i, long j) {
-    return SplitMix64(StreamSeed(seed, what) ^ SplitMix64(static_cast<std::uint64_t>(i) * 0x9E3779B1ULL +
-                                                           static_cast<std::uint64_t>(j)));
+    return SplitMix64(StreamSeed(seed, what) ^
+                      SplitMix64(static_cast<std::uint64_t>(i) * 0x9E3779B1ULL + static_cast<std::uint64_t>(j)));
   };
   std::vector<Mesh> meshes(kGroundVariants);
   for (int j = 0; j < rows; ++j) {
@@ -184,7 +185,8 @@ std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& 
     for (int i = 0; i < columns; ++i) {
       const bool mirror_u = (pick("lawn/column", i, 0) & 1U) != 0;
       Mesh& mesh = meshes[pick("lawn/variant", i, j) % kGroundVariants];
-      const double x0 = min.x() + i * tile, y0 = min.y() + j * tile, x1 = x0 + tile, y1 = y0 + tile, z = -kGroundSlabDepth;
+      const double x0 = min.x() + i * tile, y0 = min.y() + j * tile, x1 = x0 + tile, y1 = y0 + tile,
+                   z = -kGroundSlabDepth;
       // Top: the whole variant, mirrored as drawn; sides and bottom close the slab (MuJoCo wants
       // meshes with a volume) and are never seen.
       const double u0 = mirror_u ? 1.0 : 0.0, v0 = mirror_v ? 1.0 : 0.0;
@@ -200,8 +202,9 @@ std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& 
         const int corner = static_cast<int>(mesh.vertices.size());
         for (const auto& p : quads[q]) {
           mesh.vertices.push_back(p);
-          mesh.texcoords.emplace_back(q == 0 ? Eigen::Vector2d(std::abs(u0 - (p.x() - x0) / tile), std::abs(v0 - (p.y() - y0) / tile))
-                                             : Eigen::Vector2d(0.0, 0.0));
+          mesh.texcoords.emplace_back(
+              q == 0 ? Eigen::Vector2d(std::abs(u0 - (p.x() - x0) / tile), std::abs(v0 - (p.y() - y0) / tile))
+                     : Eigen::Vector2d(0.0, 0.0));
         }
         Quad(mesh, corner, corner + 1, corner + 2, corner + 3);
       }
@@ -216,10 +219,12 @@ Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth) {
   }
   const double tile = TileSize(MaterialOf(object.object_class));
   switch (object.shape) {
-    case Shape::kEllipsoid: return SuperellipsoidMesh(object, seed, 0.0, 0.0);
-    case Shape::kCylinder: return CylinderMesh(object.size, tile);
-    case Shape::kBox: return object.object_class == ObjectClass::kTrunk ? CylinderMesh(object.size, tile)
-                                                                         : BoxMesh(object.size, tile);
+    case Shape::kEllipsoid:
+      return SuperellipsoidMesh(object, seed, 0.0, 0.0);
+    case Shape::kCylinder:
+      return CylinderMesh(object.size, tile);
+    case Shape::kBox:
+      return object.object_class == ObjectClass::kTrunk ? CylinderMesh(object.size, tile) : BoxMesh(object.size, tile);
   }
   return {};
 }

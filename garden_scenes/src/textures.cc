@@ -37,8 +37,7 @@ cv::Mat NoiseOctave(cv::RNG& rng, int size, double scale_px) {
 }
 
 // Sum of noise octaves, normalized to zero mean and unit spread.
-cv::Mat FractalNoise(cv::RNG& rng, int size, const std::vector<double>& scales_px,
-                     const std::vector<double>& weights) {
+cv::Mat FractalNoise(cv::RNG& rng, int size, const std::vector<double>& scales_px, const std::vector<double>& weights) {
   cv::Mat sum = cv::Mat::zeros(size, size, CV_32F);
   for (size_t i = 0; i < scales_px.size(); ++i) {
     cv::Mat noise = NoiseOctave(rng, size, scales_px[i]);
@@ -223,26 +222,40 @@ cv::Mat Stone(cv::RNG& rng, int size) {
 
 std::string ToString(Material m) {
   switch (m) {
-    case Material::kGrass: return "grass";
-    case Material::kGravel: return "gravel";
-    case Material::kPavement: return "pavement";
-    case Material::kSoil: return "soil";
-    case Material::kFoliage: return "foliage";
-    case Material::kRoseFoliage: return "rose_foliage";
-    case Material::kTreeFoliage: return "tree_foliage";
-    case Material::kBark: return "bark";
-    case Material::kWood: return "wood";
-    case Material::kStone: return "stone";
+    case Material::kGrass:
+      return "grass";
+    case Material::kGravel:
+      return "gravel";
+    case Material::kPavement:
+      return "pavement";
+    case Material::kSoil:
+      return "soil";
+    case Material::kFoliage:
+      return "foliage";
+    case Material::kRoseFoliage:
+      return "rose_foliage";
+    case Material::kTreeFoliage:
+      return "tree_foliage";
+    case Material::kBark:
+      return "bark";
+    case Material::kWood:
+      return "wood";
+    case Material::kStone:
+      return "stone";
   }
   return "unknown";
 }
 
 Material GroundMaterial(Surface s) {
   switch (s) {
-    case Surface::kGrass: return Material::kGrass;
-    case Surface::kGravel: return Material::kGravel;
-    case Surface::kPavement: return Material::kPavement;
-    case Surface::kSoil: return Material::kSoil;
+    case Surface::kGrass:
+      return Material::kGrass;
+    case Surface::kGravel:
+      return Material::kGravel;
+    case Surface::kPavement:
+      return Material::kPavement;
+    case Surface::kSoil:
+      return Material::kSoil;
   }
   return Material::kGrass;
 }
@@ -250,12 +263,18 @@ Material GroundMaterial(Surface s) {
 Material MaterialOf(ObjectClass c) {
   switch (c) {
     case ObjectClass::kTopiary:
-    case ObjectClass::kHedge: return Material::kFoliage;
-    case ObjectClass::kRose: return Material::kRoseFoliage;
-    case ObjectClass::kTree: return Material::kTreeFoliage;
-    case ObjectClass::kTrunk: return Material::kBark;
-    case ObjectClass::kFence: return Material::kWood;
-    default: return Material::kStone;
+    case ObjectClass::kHedge:
+      return Material::kFoliage;
+    case ObjectClass::kRose:
+      return Material::kRoseFoliage;
+    case ObjectClass::kTree:
+      return Material::kTreeFoliage;
+    case ObjectClass::kTrunk:
+      return Material::kBark;
+    case ObjectClass::kFence:
+      return Material::kWood;
+    default:
+      return Material::kStone;
   }
 }
 
@@ -263,9 +282,12 @@ double TileSize(Material m) {
   switch (m) {
     case Material::kGrass:
     case Material::kGravel:
-    case Material::kSoil: return 4.0;
-    case Material::kPavement: return 2.0;
-    default: return 1.0;
+    case Material::kSoil:
+      return 4.0;
+    case Material::kPavement:
+      return 2.0;
+    default:
+      return 1.0;
   }
 }
 
@@ -277,16 +299,26 @@ namespace {
 
 cv::Mat Tile(Material material, cv::RNG& rng, int size_px) {
   switch (material) {
-    case Material::kGrass: return Grass(rng, size_px);
-    case Material::kGravel: return Gravel(rng, size_px);
-    case Material::kPavement: return Pavement(rng, size_px);
-    case Material::kSoil: return Soil(rng, size_px);
-    case Material::kFoliage: return Leaves(rng, size_px, {30, 110, 45}, 14, 0);
-    case Material::kRoseFoliage: return Leaves(rng, size_px, {35, 100, 55}, 18, size_px * size_px / 4000);
-    case Material::kTreeFoliage: return Leaves(rng, size_px, {40, 140, 80}, 20, 0);
-    case Material::kBark: return Bark(rng, size_px);
-    case Material::kWood: return Wood(rng, size_px);
-    case Material::kStone: return Stone(rng, size_px);
+    case Material::kGrass:
+      return Grass(rng, size_px);
+    case Material::kGravel:
+      return Gravel(rng, size_px);
+    case Material::kPavement:
+      return Pavement(rng, size_px);
+    case Material::kSoil:
+      return Soil(rng, size_px);
+    case Material::kFoliage:
+      return Leaves(rng, size_px, {30, 110, 45}, 14, 0);
+    case Material::kRoseFoliage:
+      return Leaves(rng, size_px, {35, 100, 55}, 18, size_px * size_px / 4000);
+    case Material::kTreeFoliage:
+      return Leaves(rng, size_px, {40, 140, 80}, 20, 0);
+    case Material::kBark:
+      return Bark(rng, size_px);
+    case Material::kWood:
+      return Wood(rng, size_px);
+    case Material::kStone:
+      return Stone(rng, size_px);
   }
   return {};
 }
@@ -333,7 +365,8 @@ cv::Mat MakeTexture(Material material, std::uint64_t seed, int size_px) {
 }
 
 std::vector<cv::Mat> MakeGroundVariants(Material material, std::uint64_t seed, int size_px) {
-  if (!IsGround(material)) throw std::invalid_argument("MakeGroundVariants: " + ToString(material) + " is not a ground");
+  if (!IsGround(material))
+    throw std::invalid_argument("MakeGroundVariants: " + ToString(material) + " is not a ground");
   // Each a tile of the variant's own seed inside, crossfaded to the base tile at the border. The
   // blend of two independent textures would lose contrast in the ramp (by up to 1/sqrt(2)): the
   // deviation from the mean is scaled back by 1 / sqrt((1 - w)^2 + w^2), so features are as strong there.

@@ -65,8 +65,8 @@ Eigen::Isometry3d ReadTransform(const YamlMap& cam, const std::string& key) {
   if (!m.allFinite()) cam.Fail(key, "must hold finite numbers");
   if (m.topRightCorner<3, 1>().norm() > 100.0) cam.Fail(key, "translation beyond 100 m");
   const Eigen::Matrix3d rotation = m.topLeftCorner<3, 3>();
-  if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 ||
-      rotation.determinant() < 0.0 || m.row(3).head<3>().norm() > 1e-9 || std::abs(m(3, 3) - 1.0) > 1e-9) {
+  if ((rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-3 || rotation.determinant() < 0.0 ||
+      m.row(3).head<3>().norm() > 1e-9 || std::abs(m(3, 3) - 1.0) > 1e-9) {
     cam.Fail(key, "not a rigid transform (rotation part is not orthonormal)");
   }
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
@@ -106,7 +106,8 @@ CameraRig CameraRig::LoadKalibr(const std::string& path, const Eigen::Isometry3d
     in.fx = k[0], in.fy = k[1], in.cx = k[2], in.cy = k[3];
     in.k1 = d[0], in.k2 = d[1], in.p1 = d[2], in.p2 = d[3];
     for (double v : resolution) {
-      if (v != std::floor(v) || v < 16 || v > 16384) cam.Fail("resolution", "must be whole pixel counts in [16, 16384]");
+      if (v != std::floor(v) || v < 16 || v > 16384)
+        cam.Fail("resolution", "must be whole pixel counts in [16, 16384]");
     }
     in.width = static_cast<int>(resolution[0]);
     in.height = static_cast<int>(resolution[1]);

@@ -132,10 +132,10 @@ void CollisionEnvironment::AddOccupiedPoints(const std::string& name, const std:
 struct CollisionModel::Robot {
   struct Link {
     std::string name;
-    int parent = -1;              // index, -1 for the root
+    int parent = -1;                     // index, -1 for the root
     const urdf::Joint* joint = nullptr;  // from the parent
-    int varied = -1;              // index into q, or -1 (joint held at zero)
-    bool moving = false;          // a varied joint lies between it and the root
+    int varied = -1;                     // index into q, or -1 (joint held at zero)
+    bool moving = false;                 // a varied joint lies between it and the root
   };
   struct Shape {
     int link = 0;
@@ -148,6 +148,27 @@ struct CollisionModel::Robot {
   std::vector<std::pair<int, int>> self_pairs;  // shape indices
   std::vector<int> moving_shapes, static_shapes;
 
+  // The URDF's links in breadth-first order from the root, with the joints in `varied_joints` free.
+  void AddLinkTree(const urdf::ModelInterface& urdf, const std::vector<std::string>& varied_joints) {
+    std::map<std::string, int> index;
+    std::vector<urdf::LinkConstSharedPtr> queue{urdf.getRoot()};
+    for (size_t k = 0; k < queue.size(); ++k) {
+      const auto& link = queue[k];
+      Link node;
+      node.name = link->name;
+      if (link->parent_joint) {
+        node.parent = index.at(link->parent_joint->parent_link_name);
+        node.joint = link->parent_joint.get();
+        const auto varied = std::find(varied_joints.begin(), varied_joints.end(), node.joint->name);
+        if (varied != varied_joints.end()) node.varied = static_cast<int>(varied - varied_joints.begin());
+        node.moving = node.varied >= 0 || links[node.parent].moving;
+      }
+      index[node.name] = static_cast<int>(links.size());
+      links.push_back(node);
+      for (const auto& child : link->child_links) queue.push_back(child);
+    }
+  }
+
   std::vector<Eigen::Isometry3d> LinkPoses(const Eigen::VectorXd& q, const Eigen::Isometry3d& root) const {
     std::vector<Eigen::Isometry3d> poses(links.size());
     for (size_t i = 0; i < links.size(); ++i) {
@@ -156,8 +177,8 @@ struct CollisionModel::Robot {
         poses[i] = root;
         continue;
       }
-      poses[i] = poses[link.parent] *
-                 RobotDescription::JointTransform(*link.joint, link.varied >= 0 ? q[link.varied] : 0.0);
+      poses[i] =
+          poses[link.parent] * RobotDescription::JointTransform(*link.joint, link.varied >= 0 ? q[link.varied] : 0.0);
     }
     return poses;
   }
@@ -166,24 +187,7 @@ struct CollisionModel::Robot {
 CollisionModel::CollisionModel(const RobotDescription& description, const std::vector<std::string>& varied_joints)
     : robot_(std::make_unique<Robot>()) {
   const urdf::ModelInterface& urdf = description.urdf();
-  // Links in breadth-first order from the root.
-  std::map<std::string, int> index;
-  std::vector<urdf::LinkConstSharedPtr> queue{urdf.getRoot()};
-  for (size_t k = 0; k < queue.size(); ++k) {
-    const auto& link = queue[k];
-    Robot::Link node;
-    node.name = link->name;
-    if (link->parent_joint) {
-      node.parent = index.at(link->parent_joint->parent_link_name);
-      node.joint = link->parent_joint.get();
-      const auto varied = std::find(varied_joints.begin(), varied_joints.end(), node.joint->name);
-      if (varied != varied_joints.end()) node.varied = static_cast<int>(varied - varied_joints.begin());
-      node.moving = node.varied >= 0 || robot_->links[node.parent].moving;
-    }
-    index[node.name] = static_cast<int>(robot_->links.size());
-    robot_->links.push_back(node);
-    for (const auto& child : link->child_links) queue.push_back(child);
-  }
+  robot_->AddLinkTree(urdf, varied_joints);
   for (const auto& name : varied_joints) {
     if (!urdf.getJoint(name)) throw InputError(description.path(), "no joint named '" + name + "'");
   }
@@ -217,8 +221,10 @@ CollisionModel::CollisionModel(const RobotDescription& description, const std::v
       shape.link = i;
       shape.label = link->name + (link->collision_array.size() > 1 ? "/" + std::to_string(k) : "");
       shape.origin = ToIsometry(collision->origin);
-      shape.object = std::make_unique<fcl::CollisionObjectd>(UrdfGeometry(*collision->geometry, description.path(), link->name));
-      (robot_->links[i].moving ? robot_->moving_shapes : robot_->static_shapes).push_back(static_cast<int>(robot_->shapes.size()));
+      shape.object =
+          std::make_unique<fcl::CollisionObjectd>(UrdfGeometry(*collision->geometry, description.path(), link->name));
+      (robot_->links[i].moving ? robot_->moving_shapes : robot_->static_shapes)
+          .push_back(static_cast<int>(robot_->shapes.size()));
       robot_->shapes.push_back(std::move(shape));
       ++k;
     }

@@ -54,8 +54,8 @@ RobotDescription RobotDescription::Load(const std::string& urdf_path) {
   if (model.getRoot() == nullptr || model.getRoot()->name != RobotFrames::kBase) {
     throw InputError(urdf_path, std::string("the root link must be '") + RobotFrames::kBase + "'");
   }
-  std::vector<std::string> required_links = {RobotFrames::kImu, RobotFrames::kCameraRing,
-                                             RobotFrames::kEndEffector, RobotFrames::kLeftWheelLink};
+  std::vector<std::string> required_links = {RobotFrames::kImu, RobotFrames::kCameraRing, RobotFrames::kEndEffector,
+                                             RobotFrames::kLeftWheelLink};
   for (int i = 0; i < 10; ++i) required_links.push_back(RobotFrames::CameraOptical(i));
   for (const auto& name : required_links) {
     if (!model.getLink(name)) throw InputError(urdf_path, "missing link '" + name + "'");
@@ -118,8 +118,8 @@ Eigen::Isometry3d RobotDescription::FramePose(const std::string& link,
 std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() const {
   Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d high = -low;
-  for (const std::string& name : {std::string(RobotFrames::kBase), std::string(RobotFrames::kLeftWheelLink),
-                                  std::string("right_wheel_link")}) {
+  for (const std::string& name :
+       {std::string(RobotFrames::kBase), std::string(RobotFrames::kLeftWheelLink), std::string("right_wheel_link")}) {
     const auto link = model_->getLink(name);
     if (!link) continue;
     const Eigen::Isometry3d T_base_link = FramePose(name);

@@ -21,12 +21,12 @@ robot::WheelSpeeds BaseController::Update(double dt) {
 }
 
 robot::WheelSpeeds BaseController::ActuatorSetpoints(const robot::WheelSpeeds& measured, double dt) {
-  constexpr double kIntegralGain = 20.0;   // 1/s: removes a speed error in ~50 ms
-  constexpr double kIntegralLimit = 2.0;   // rad/s, anti-windup
-  integral_.left = std::clamp(integral_.left + kIntegralGain * (target_.left - measured.left) * dt, -kIntegralLimit,
-                              kIntegralLimit);
-  integral_.right = std::clamp(integral_.right + kIntegralGain * (target_.right - measured.right) * dt,
-                               -kIntegralLimit, kIntegralLimit);
+  constexpr double kIntegralGain = 20.0;  // 1/s: removes a speed error in ~50 ms
+  constexpr double kIntegralLimit = 2.0;  // rad/s, anti-windup
+  integral_.left =
+      std::clamp(integral_.left + kIntegralGain * (target_.left - measured.left) * dt, -kIntegralLimit, kIntegralLimit);
+  integral_.right = std::clamp(integral_.right + kIntegralGain * (target_.right - measured.right) * dt, -kIntegralLimit,
+                               kIntegralLimit);
   return {target_.left + integral_.left, target_.right + integral_.right};
 }
 

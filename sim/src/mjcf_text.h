@@ -19,8 +19,8 @@ inline std::string Vec(const Eigen::Vector3d& v) { return Num(v.x()) + " " + Num
 
 inline std::string PoseAttributes(const Eigen::Isometry3d& pose) {
   const Eigen::Quaterniond q(pose.rotation());
-  return "pos=\"" + Vec(pose.translation()) + "\" quat=\"" + Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) +
-         " " + Num(q.z()) + "\"";
+  return "pos=\"" + Vec(pose.translation()) + "\" quat=\"" + Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) + " " +
+         Num(q.z()) + "\"";
 }
 
 }  // namespace trimbot::sim::mjcf

@@ -12,9 +12,8 @@ RenderPinhole RenderPinholeFor(const robot::PinholeRadtan& camera, double oversa
   constexpr int kSamples = 64;
   for (int i = 0; i <= kSamples; ++i) {
     const double s = static_cast<double>(i) / kSamples;
-    for (const Eigen::Vector2d& pixel :
-         {Eigen::Vector2d(-0.5 + s * w, -0.5), Eigen::Vector2d(-0.5 + s * w, h - 0.5),
-          Eigen::Vector2d(-0.5, -0.5 + s * h), Eigen::Vector2d(w - 0.5, -0.5 + s * h)}) {
+    for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(-0.5 + s * w, -0.5), Eigen::Vector2d(-0.5 + s * w, h - 0.5),
+                                         Eigen::Vector2d(-0.5, -0.5 + s * h), Eigen::Vector2d(w - 0.5, -0.5 + s * h)}) {
       const Eigen::Vector2d ray = camera.Undistort(pixel);
       max_x = std::max(max_x, std::abs(ray.x()));
       max_y = std::max(max_y, std::abs(ray.y()));

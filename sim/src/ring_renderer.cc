@@ -2,12 +2,12 @@
 
 #include <GL/osmesa.h>
 
-#include <opencv2/imgproc.hpp>
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 namespace trimbot::sim {
@@ -45,15 +45,20 @@ std::array<Plane, 6> ViewVolume(const mjvGLCamera& camera, double aspect) {
   const Vec3 up = ToVec(camera.up).normalized(), right = forward.cross(up);
   const double near = camera.frustum_near;
   const double half_width = 0.5 * aspect * (camera.frustum_top - camera.frustum_bottom);
-  const double left = (camera.frustum_center - half_width) / near, rightmost = (camera.frustum_center + half_width) / near;
+  const double left = (camera.frustum_center - half_width) / near,
+               rightmost = (camera.frustum_center + half_width) / near;
   const double bottom = camera.frustum_bottom / near, top = camera.frustum_top / near;
   auto side = [&](const Vec3& axis, double slope, double sign) {
     // Points with sign * (axis . (x - eye) - slope * forward . (x - eye)) > 0 are outside.
     const Vec3 normal = (sign * (axis - slope * forward)).normalized();
     return Plane{normal, normal.dot(eye)};
   };
-  return {side(right, rightmost, 1.0), side(right, left, -1.0), side(up, top, 1.0), side(up, bottom, -1.0),
-          Plane{-forward, -forward.dot(eye) - near}, Plane{forward, forward.dot(eye) + camera.frustum_far}};
+  return {side(right, rightmost, 1.0),
+          side(right, left, -1.0),
+          side(up, top, 1.0),
+          side(up, bottom, -1.0),
+          Plane{-forward, -forward.dot(eye) - near},
+          Plane{forward, forward.dot(eye) + camera.frustum_far}};
 }
 
 // Keeps in the scene only the geoms that can show in this camera: those whose bounding sphere,
@@ -91,8 +96,8 @@ int KeepVisibleGeoms(mjvScene* scene, double aspect) {
     for (size_t l = 0; !visible && l < shadow_directions.size(); ++l) {
       const Vec3& direction = shadow_directions[l];
       // The shadow falls along the light until the ground (z = 0).
-      const double length = direction.z() < -1e-3 ? std::min((centre.z() + radius) / -direction.z(), longest_shadow)
-                                                   : longest_shadow;
+      const double length =
+          direction.z() < -1e-3 ? std::min((centre.z() + radius) / -direction.z(), longest_shadow) : longest_shadow;
       visible = !capsule_outside(centre, centre + std::max(length, 0.0) * direction, radius);
     }
     if (visible) scene->geoms[kept++] = geom;
@@ -105,7 +110,10 @@ int KeepVisibleGeoms(mjvScene* scene, double aspect) {
 }  // namespace
 
 RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, bool frustum_culling, double oversampling)
-    : world_(world), rig_(rig), frustum_culling_(frustum_culling), oversampling_(oversampling),
+    : world_(world),
+      rig_(rig),
+      frustum_culling_(frustum_culling),
+      oversampling_(oversampling),
       gl_(std::make_unique<GlState>()) {
   const mjModel* m = world.model();
   const int width = m->vis.global.offwidth, height = m->vis.global.offheight;
@@ -180,9 +188,9 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   view.type = mjCAMERA_FIXED;
   view.fixedcamid = camera_id;
   mjv_updateScene(m, world_.data(), &gl_->option, nullptr, &view, mjCAT_ALL, &gl_->scene);
-  const int culled = frustum_culling_
-                         ? KeepVisibleGeoms(&gl_->scene, static_cast<double>(camera.render.width) / camera.render.height)
-                         : 0;
+  const int culled =
+      frustum_culling_ ? KeepVisibleGeoms(&gl_->scene, static_cast<double>(camera.render.width) / camera.render.height)
+                       : 0;
   if (!segmentation) {
     timings_.geoms_in_view += gl_->scene.ngeom;
     timings_.geoms_culled += culled;

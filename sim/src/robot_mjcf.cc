@@ -72,8 +72,8 @@ class MjcfEmitter {
       default:
         throw InputError(robot_.path(), "geom '" + name + "': only box, cylinder and sphere geometry is supported");
     }
-    out_ << std::string(indent, ' ') << "<geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\""
-         << type << "\" size=\"" << size << "\" " << PoseAttributes(robot::ToIsometry(origin)) << extra << "/>\n";
+    out_ << std::string(indent, ' ') << "<geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"" << type
+         << "\" size=\"" << size << "\" " << PoseAttributes(robot::ToIsometry(origin)) << extra << "/>\n";
     labels_.push_back({name, ObjectClass::kRobot, garden::kRobotObjectId, false, garden::Surface::kGrass});
   }
 
@@ -97,8 +97,8 @@ class MjcfEmitter {
       inertia << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
       inertia = origin.linear() * inertia * origin.linear().transpose();
       out_ << pad << "<inertial pos=\"" << Vec(origin.translation()) << "\" mass=\"" << Num(in.mass)
-           << "\" fullinertia=\"" << Num(inertia(0, 0)) << " " << Num(inertia(1, 1)) << " " << Num(inertia(2, 2))
-           << " " << Num(inertia(0, 1)) << " " << Num(inertia(0, 2)) << " " << Num(inertia(1, 2)) << "\"/>\n";
+           << "\" fullinertia=\"" << Num(inertia(0, 0)) << " " << Num(inertia(1, 1)) << " " << Num(inertia(2, 2)) << " "
+           << Num(inertia(0, 1)) << " " << Num(inertia(0, 2)) << " " << Num(inertia(1, 2)) << "\"/>\n";
     }
     for (size_t i = 0; i < link.visual_array.size(); ++i) {
       const auto& visual = *link.visual_array[i];
@@ -146,7 +146,8 @@ class MjcfEmitter {
         break;
       }
       default:
-        throw InputError(robot_.path(), "joint '" + joint.name + "': only fixed, revolute and continuous joints are supported");
+        throw InputError(robot_.path(),
+                         "joint '" + joint.name + "': only fixed, revolute and continuous joints are supported");
     }
     LinkContents(link, indent + 2);
     out_ << pad << "</body>\n";
@@ -159,8 +160,7 @@ class MjcfEmitter {
       const Eigen::Isometry3d T_ring_cam = T_base_ring.inverse() * cam.T_base_camera;
       const RenderPinhole render = RenderPinholeFor(cam.intrinsics, oversampling_);
       out_ << std::string(indent, ' ') << "<camera name=\"" << cam.name << "\" "
-           << PoseAttributes(OpticalToMujocoCamera(T_ring_cam)) << " fovy=\"" << Num(render.fovy_degrees)
-           << "\"/>\n";
+           << PoseAttributes(OpticalToMujocoCamera(T_ring_cam)) << " fovy=\"" << Num(render.fovy_degrees) << "\"/>\n";
     }
   }
 
@@ -178,7 +178,8 @@ constexpr const char* kDefaults =
     "  <default>\n"
     "    <default class=\"robot\">\n"
     "      <default class=\"visual\"><geom contype=\"0\" conaffinity=\"0\" group=\"1\"/></default>\n"
-    "      <default class=\"collision\"><geom contype=\"2\" conaffinity=\"5\" group=\"3\" friction=\"0.5 0.005 0.0001\"/>\n"
+    "      <default class=\"collision\"><geom contype=\"2\" conaffinity=\"5\" group=\"3\" friction=\"0.5 0.005 "
+    "0.0001\"/>\n"
     "        <default class=\"arm_collision\"><geom contype=\"6\" conaffinity=\"5\"/></default>\n"
     "      </default>\n"
     "      <default class=\"drive_joint\"><joint damping=\"0.01\" armature=\"0.01\"/></default>\n"
@@ -219,7 +220,8 @@ RobotMjcf ComposeRobot(const robot::RobotDescription& robot, const robot::Camera
   xml << "<mujoco model=\"" << robot.urdf().getName() << "\">\n"
       << "  <!-- Composed by sim/robot_mjcf from " << FileName(robot.path()) << " and " << FileName(rig.source())
       << "; start x y yaw " << Num(options.start.x) << " " << Num(options.start.y) << " " << Num(options.start.yaw)
-      << ", render oversampling " << Num(options.render_oversampling) << ". -->\n"
+      << ", render oversampling " << Num(options.render_oversampling)
+      << ". -->\n"
       // The URDF's angles are in radians and its links carry their inertia.
       << "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
       // The servos and the wheel motors' gains are for the implicit integrator.

@@ -3,16 +3,16 @@
 #include <opencv2/core.hpp>
 
 #include <chrono>
-#include <map>
 #include <cmath>
+#include <map>
 
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
 #include "trimbot/sim/arm_controller.h"
 #include "trimbot/sim/base_controller.h"
 #include "trimbot/sim/camera_exposure.h"
-#include "trimbot/sim/imu_model.h"
 #include "trimbot/sim/camera_noise.h"
+#include "trimbot/sim/imu_model.h"
 #include "trimbot/sim/ring_renderer.h"
 #include "trimbot/sim/wheel_encoder_model.h"
 #include "trimbot/sim/world.h"
@@ -70,19 +70,19 @@ struct Simulator::Impl {
   garden::SlipModel ground_slip[4];
   std::vector<bool> fault_applied;
   int end_effector_body = -1;
-  SimulatorTimings timings;     // physics and exposure/noise here; the renderer keeps its own
+  SimulatorTimings timings;  // physics and exposure/noise here; the renderer keeps its own
 };
 
 Simulator::Simulator(const SimulatorConfig& config)
     : config_(config),
       robot_(robot::RobotDescription::Load(config.robot.urdf)),
       parameters_(robot::RobotParameters::Load(config.robot.robot_parameters)),
-      rig_(robot::CameraRig::LoadKalibr(config.robot.camchain,
-                                        robot_.FramePose(RobotFrames::CameraOptical(0)))),
+      rig_(robot::CameraRig::LoadKalibr(config.robot.camchain, robot_.FramePose(RobotFrames::CameraOptical(0)))),
       garden_(GardenWithExtraObjects(config)),
       impl_(std::make_unique<Impl>()) {
   if (rig_.size() != 10) {
-    throw InputError(config.robot.camchain, "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));
+    throw InputError(config.robot.camchain,
+                     "the ring needs 10 cameras, the calibration has " + std::to_string(rig_.size()));
   }
   WorldOptions options;
   options.timestep = config.timestep;
@@ -105,7 +105,8 @@ Simulator::Simulator(const SimulatorConfig& config)
   }
   impl_->imu = std::make_unique<ImuModel>(parameters_.imu, config.seed);
   impl_->encoders = std::make_unique<WheelEncoderModel>(parameters_.wheel_encoders.ticks_per_revolution, config.seed);
-  for (auto surface : {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement, garden::Surface::kSoil}) {
+  for (auto surface :
+       {garden::Surface::kGrass, garden::Surface::kGravel, garden::Surface::kPavement, garden::Surface::kSoil}) {
     garden::SlipModel& slip = impl_->ground_slip[static_cast<int>(surface)];
     slip = garden::PropertiesOf(surface).slip;
     slip.mean *= config.wheel_slip_scale;
@@ -332,7 +333,8 @@ RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool wi
   for (int i = 0; i < rig_.size(); ++i) {
     const int id = world.camera_id(i);
     Eigen::Isometry3d T_map_camera = PoseFromMujoco(world.data()->cam_xpos + 3 * id, world.data()->cam_xmat + 9 * id);
-    T_map_camera.linear() = T_map_camera.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+    T_map_camera.linear() =
+        T_map_camera.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
     truth.T_map_camera.push_back(T_map_camera);
   }
   ++impl_->frame;
@@ -370,11 +372,13 @@ std::vector<ObstacleContact> Simulator::ObstacleContacts() const {
   std::vector<ObstacleContact> contacts;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& contact = d->contact[i];
-    for (const auto& [robot_geom, other] : {std::pair{contact.geom1, contact.geom2}, std::pair{contact.geom2, contact.geom1}}) {
+    for (const auto& [robot_geom, other] :
+         {std::pair{contact.geom1, contact.geom2}, std::pair{contact.geom2, contact.geom1}}) {
       const GeomLabel* object = world.label(other);
       if (world.is_robot_geom(robot_geom) && object != nullptr && !object->is_ground &&
           object->object_class != garden::ObjectClass::kRobot) {
-        contacts.push_back({mj_id2name(world.model(), mjOBJ_GEOM, robot_geom), object->geom_name, object->object_class});
+        contacts.push_back(
+            {mj_id2name(world.model(), mjOBJ_GEOM, robot_geom), object->geom_name, object->object_class});
       }
     }
   }
@@ -397,8 +401,8 @@ std::vector<ArmContact> Simulator::ArmContacts() const {
   return contacts;
 }
 
-cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth,
-                                      double elevation, int width, int height) {
+cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
+                                      int width, int height) {
   if (!impl_->renderer) throw std::logic_error("RenderExternalView: the simulator was configured without cameras");
   mj_forward(impl_->world->model(), impl_->world->data());
   return impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);

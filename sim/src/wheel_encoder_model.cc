@@ -11,7 +11,8 @@ void WheelEncoderModel::AdvanceWheel(Wheel& wheel, double dt, double rotation, c
   double slip = 0.0;
   if (surface != nullptr) {
     const double decay = std::exp(-dt / surface->correlation_time);
-    wheel.slip_state = decay * wheel.slip_state + surface->sigma * std::sqrt(1.0 - decay * decay) * StandardNormal(rng_);
+    wheel.slip_state =
+        decay * wheel.slip_state + surface->sigma * std::sqrt(1.0 - decay * decay) * StandardNormal(rng_);
     slip = surface->mean + wheel.slip_state + wheel.extra_slip;
   }
   wheel.measured_angle += rotation * (1.0 + slip);

@@ -84,11 +84,13 @@ std::string TextureAssets(const garden::Garden& garden, const WorldOptions& opti
   const auto add_texture = [&](const std::string& name, int size, const std::function<cv::Mat()>& make) {
     const std::string file = WriteTexture(name, make, garden.appearance_seed, size, options, texture_dir);
     assets << "    <texture name=\"" << name << "\" type=\"2d\" file=\"" << file << "\"/>\n"
-           << "    <material name=\"" << name << "\" texture=\"" << name << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
+           << "    <material name=\"" << name << "\" texture=\"" << name
+           << "\" specular=\"0.05\" shininess=\"0.05\"/>\n";
   };
   for (const auto material : materials) {
     const int size = TextureSize(material, options);
-    add_texture(garden::ToString(material), size, [&] { return garden::MakeTexture(material, garden.appearance_seed, size); });
+    add_texture(garden::ToString(material), size,
+                [&] { return garden::MakeTexture(material, garden.appearance_seed, size); });
   }
   const int lawn_size = TextureSize(lawn, options);
   std::vector<cv::Mat> variants;  // made once, and only when one of them is not in the cache
@@ -129,8 +131,8 @@ class GardenEmitter {
     labels_.push_back({"garden/ground", ObjectClass::kGround, garden::kGroundObjectId, true, garden_.ground});
   }
 
-  void Mesh(const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose,
-            const std::string& material, const std::string& geom_class) {
+  void Mesh(const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose, const std::string& material,
+            const std::string& geom_class) {
     assets_ << "    <mesh name=\"" << name << "\" vertex=\"";
     for (const auto& v : mesh.vertices) assets_ << Num(v.x()) << ' ' << Num(v.y()) << ' ' << Num(v.z()) << ' ';
     assets_ << "\" texcoord=\"";
@@ -140,8 +142,8 @@ class GardenEmitter {
     assets_ << "\"/>\n";
     Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
     iso.matrix() = pose;
-    geoms_ << "    <geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"mesh\" mesh=\"" << name
-           << "\" " << PoseAttributes(iso) << " material=\"" << material << "\"/>\n";
+    geoms_ << "    <geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"mesh\" mesh=\"" << name << "\" "
+           << PoseAttributes(iso) << " material=\"" << material << "\"/>\n";
   }
 
   // The lawn's variants at twice the tile: 4 mm a texel for grass, the scale the lawn had as a
@@ -203,7 +205,8 @@ std::string Lights(const garden::Sun& sun) {
       << Vec(towards_sun * 20.0) << "\" dir=\"" << Vec(-towards_sun) << "\" diffuse=\"" << Vec(sun_colour)
       << "\" specular=\"0.1 0.1 0.1\"/>\n"
       << "    <light name=\"sky\" directional=\"true\" castshadow=\"false\" pos=\"0 0 20\" dir=\"0 0 -1\" "
-         "diffuse=\"0.15 0.16 0.18\" ambient=\"" << Vec(sun.ambient) << "\" specular=\"0 0 0\"/>\n";
+         "diffuse=\"0.15 0.16 0.18\" ambient=\""
+      << Vec(sun.ambient) << "\" specular=\"0 0 0\"/>\n";
   return xml.str();
 }
 
@@ -237,8 +240,8 @@ std::string DefaultTextureCacheDir() {
   return error ? std::string() : (temp / "trimbot_texture_cache").string();
 }
 
-WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig,
-                       const garden::Garden& garden, const WorldOptions& options, const std::string& output_dir) {
+WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig, const garden::Garden& garden,
+                       const WorldOptions& options, const std::string& output_dir) {
   const fs::path dir = fs::path(output_dir);
   const fs::path texture_dir = dir / "textures";
   fs::create_directories(texture_dir);

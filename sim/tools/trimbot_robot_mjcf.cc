@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string robot_dir = argv[1];
-  const std::filesystem::path output = argc == 3 ? std::filesystem::path(argv[2])
-                                                 : std::filesystem::path(robot_dir) / trimbot::sim::kRobotMjcfFile;
+  const std::filesystem::path output =
+      argc == 3 ? std::filesystem::path(argv[2]) : std::filesystem::path(robot_dir) / trimbot::sim::kRobotMjcfFile;
   try {
     const std::string xml = trimbot::sim::NominalRobotMjcf(robot_dir);
     if (output.has_parent_path()) std::filesystem::create_directories(output.parent_path());

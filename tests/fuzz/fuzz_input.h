@@ -14,8 +14,8 @@ namespace trimbot::fuzz {
 
 inline std::string WriteInput(const std::uint8_t* data, std::size_t size, const std::string& extension) {
   static const std::string path = "/tmp/trimbot_fuzz_" + std::to_string(getpid()) + extension;
-  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data),
-                                                                 static_cast<std::streamsize>(size));
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;
 }
 

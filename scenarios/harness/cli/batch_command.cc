@@ -19,11 +19,14 @@ void AddBatchCommands(Commands& commands) {
   auto* run = app.add_subcommand("run", "run a scenario's navigation trials headless and report against its criteria");
   run->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
   run->add_option("--out", options->out_dir, "output folder")->required();
-  auto* trials_option = run->add_option("--trials", *trials, "number of trials (default: the scenario's)")
-                            ->check(CLI::Range(1, 100000));
-  auto* seed_option = run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
-  run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
-  auto* shard_option = run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
+  auto* trials_option =
+      run->add_option("--trials", *trials, "number of trials (default: the scenario's)")->check(CLI::Range(1, 100000));
+  auto* seed_option =
+      run->add_option("--seed", *seed, "batch seed; trial i runs with seed + i (default: the scenario's)");
+  run->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
+      ->check(CLI::Range(1, 256));
+  auto* shard_option =
+      run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
   run->add_option("--set", options->overrides,
                   "override a scenario or stack parameter, key.path=value (repeatable), e.g. "
@@ -41,10 +44,12 @@ void AddBatchCommands(Commands& commands) {
 
   auto shard_dirs = std::make_shared<std::vector<std::string>>();
   auto merged_out = std::make_shared<std::string>();
-  auto* merge = app.add_subcommand("merge", "merge the output folders of a batch's shards and report on the whole batch");
+  auto* merge =
+      app.add_subcommand("merge", "merge the output folders of a batch's shards and report on the whole batch");
   merge->add_option("shards", *shard_dirs, "output folders of `trimbot run --shard`")->required();
   merge->add_option("--out", *merged_out, "output folder of the merged batch")->required();
-  commands.OnRun(merge, [shard_dirs, merged_out, &commands] { return MergeShards(*shard_dirs, *merged_out, commands.paths()); });
+  commands.OnRun(
+      merge, [shard_dirs, merged_out, &commands] { return MergeShards(*shard_dirs, *merged_out, commands.paths()); });
 }
 
 }  // namespace trimbot::scenarios

@@ -43,12 +43,12 @@ class Commands {
 // The commands, in the order `trimbot --help` lists them (one file each in cli/).
 void AddDriveCommand(Commands& commands);
 void AddBenchCommand(Commands& commands);
-void AddGardenCommands(Commands& commands);         // garden import-csv | generate | export
-void AddBatchCommands(Commands& commands);          // run, merge
-void AddRegistrationCommands(Commands& commands);   // register, register-set
+void AddGardenCommands(Commands& commands);        // garden import-csv | generate | export
+void AddBatchCommands(Commands& commands);         // run, merge
+void AddRegistrationCommands(Commands& commands);  // register, register-set
 void AddCompareCommand(Commands& commands);
-void AddTuningCommands(Commands& commands);         // sweep, tune
-void AddMapCommands(Commands& commands);            // map build | ensure | bench | retrieval-eval
+void AddTuningCommands(Commands& commands);  // sweep, tune
+void AddMapCommands(Commands& commands);     // map build | ensure | bench | retrieval-eval
 void AddFusionCommand(Commands& commands);
 void AddStereoCommand(Commands& commands);
 

@@ -12,12 +12,13 @@ void AddDriveCommand(Commands& commands) {
   auto seed = std::make_shared<std::uint64_t>(0);
   auto seconds = std::make_shared<double>(0.0);
   auto no_cameras = std::make_shared<bool>(false);
-  auto* drive = commands.app().add_subcommand("drive", "drive the robot headless through a drive plan and record everything");
+  auto* drive =
+      commands.app().add_subcommand("drive", "drive the robot headless through a drive plan and record everything");
   drive->add_option("plan", options->plan_path, "drive plan (YAML)")->required();
   drive->add_option("--out", options->output_dir, "output folder")->required();
   auto* seed_option = drive->add_option("--seed", *seed, "noise seed (default: the plan's)");
-  auto* seconds_option = drive->add_option("--seconds", *seconds, "stop after this much simulated time")
-                             ->check(CLI::Range(1e-3, 1e6));
+  auto* seconds_option =
+      drive->add_option("--seconds", *seconds, "stop after this much simulated time")->check(CLI::Range(1e-3, 1e6));
   drive->add_option("--calibration", options->calibration_path, "camera calibration (Kalibr camchain)");
   drive->add_option("--resolution-scale", options->resolution_scale, "render at this fraction of 752x480")
       ->check(CLI::Range(0.1, 1.0));

@@ -14,7 +14,8 @@ void AddFusionCommand(Commands& commands) {
   command->add_option("--out", options->out, "output folder")->required();
   command->add_option("--interval", options->fusion.interval, "seconds between clouds")->check(CLI::Range(1e-3, 1e4));
   command->add_option("--clouds", options->clouds, "number of registrations")->check(CLI::Range(1, 10000));
-  command->add_option("--stride", options->fusion.stride, "pixel stride of the stereo clouds")->check(CLI::Range(1, 64));
+  command->add_option("--stride", options->fusion.stride, "pixel stride of the stereo clouds")
+      ->check(CLI::Range(1, 64));
   command->add_option("--ground-keep", options->fusion.ground_keep, "fraction of ground points kept")
       ->check(CLI::Range(0.0, 1.0));
   commands.OnRun(command, [options, &commands] { return RunFusionDrive(*options, commands.paths()); });

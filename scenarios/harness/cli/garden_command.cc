@@ -30,9 +30,11 @@ void AddGardenCommands(Commands& commands) {
 
   auto* import_cmd = garden_cmd->add_subcommand("import-csv", "convert a GardenUI object map (CSV) to a garden file");
   import_cmd->add_option("csv", options->input, "object map")->required();
-  import_cmd->add_option("--name", options->name, "garden name")->required()->check(CLI::Validator(
-      [](std::string& name) { return IsPlainName(name) ? std::string() : "'" + name + "' is not a plain name"; },
-      "NAME"));
+  import_cmd->add_option("--name", options->name, "garden name")
+      ->required()
+      ->check(CLI::Validator(
+          [](std::string& name) { return IsPlainName(name) ? std::string() : "'" + name + "' is not a plain name"; },
+          "NAME"));
   import_cmd->add_option("--ground-z", options->ground_z, "z of the ground in the CSV (Wageningen: -1.48)")
       ->check(CLI::Range(-1e4, 1e4));
   import_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");
@@ -49,24 +51,30 @@ void AddGardenCommands(Commands& commands) {
   generate_cmd->add_option("--hedges", g.hedges, "number of hedges")->check(CLI::Range(0, 1000));
   generate_cmd->add_option("--trees", g.trees, "number of trees")->check(CLI::Range(0, 1000));
   generate_cmd->add_option("--obstacles", g.obstacles, "number of other obstacles")->check(CLI::Range(0, 1000));
-  generate_cmd->add_option("--paths", g.paths, "number of paths (gravel, pavement, soil in turn)")->check(CLI::Range(0, 100));
-  generate_cmd->add_option("--clearance", g.robot_clearance, "free space kept between objects (m)")->check(CLI::Range(0.0, 10.0));
+  generate_cmd->add_option("--paths", g.paths, "number of paths (gravel, pavement, soil in turn)")
+      ->check(CLI::Range(0, 100));
+  generate_cmd->add_option("--clearance", g.robot_clearance, "free space kept between objects (m)")
+      ->check(CLI::Range(0.0, 10.0));
   generate_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");
   commands.OnRun(generate_cmd, [options] {
     options->generator.size = ParseGardenSize(options->size);
-    return GenerateGardenFile(options->generator, "--seed " + std::to_string(options->generator.seed) + " --size " +
-                                                      options->size, options->output);
+    return GenerateGardenFile(options->generator,
+                              "--seed " + std::to_string(options->generator.seed) + " --size " + options->size,
+                              options->output);
   });
 
   auto* export_cmd = garden_cmd->add_subcommand("export", "write the occupancy map (map_server) and ground-truth PLY");
   export_cmd->add_option("garden", options->input, "garden name or file")->required();
   export_cmd->add_option("--out", options->output, "output folder")->required();
-  export_cmd->add_option("--resolution", options->resolution, "occupancy cell size (m)")->check(CLI::Range(0.005, 10.0));
-  export_cmd->add_option("--clearance", options->clearance,
-                         "objects starting higher than this (tree crowns) are not obstacles (m)")
+  export_cmd->add_option("--resolution", options->resolution, "occupancy cell size (m)")
+      ->check(CLI::Range(0.005, 10.0));
+  export_cmd
+      ->add_option("--clearance", options->clearance,
+                   "objects starting higher than this (tree crowns) are not obstacles (m)")
       ->check(CLI::Range(0.0, 100.0));
   export_cmd->add_option("--growth", options->growth, "seasonal growth 0..1")->check(CLI::Range(0.0, 1.0));
-  export_cmd->add_option("--points-per-m2", options->point_density, "PLY sampling density")->check(CLI::Range(1.0, 1e5));
+  export_cmd->add_option("--points-per-m2", options->point_density, "PLY sampling density")
+      ->check(CLI::Range(1.0, 1e5));
   commands.OnRun(export_cmd, [options, &commands] {
     GardenExport exported;
     exported.garden = options->input;

@@ -26,26 +26,31 @@ void AddEvalCommand(Commands& commands, CLI::App* map, const std::string& name, 
   command->add_option("plan", options->drive.plan_path, "drive plan (YAML) of the query drive")->required();
   command->add_option("--out", options->out_dir, "output folder")->required();
   auto* seed_option = command->add_option("--seed", *seed, "seed of the query drive (default: the plan's + 2000)");
-  auto* time_option = command->add_option("--time-of-day", *time_of_day, "h (default: the plan's)")->check(CLI::Range(0.0, 24.0));
+  auto* time_option =
+      command->add_option("--time-of-day", *time_of_day, "h (default: the plan's)")->check(CLI::Range(0.0, 24.0));
   auto* day_option = command->add_option("--day-of-year", *day, "(default: the plan's)")->check(CLI::Range(1, 366));
-  auto* growth_option = command->add_option("--growth", *growth, "0..1 (default: the plan's)")->check(CLI::Range(0.0, 1.0));
+  auto* growth_option =
+      command->add_option("--growth", *growth, "0..1 (default: the plan's)")->check(CLI::Range(0.0, 1.0));
   command->add_option("--lateral-offset", options->drive.lateral_offset, "m: drive this far left of the plan's start")
       ->check(CLI::Range(-5.0, 5.0));
   command->add_option("--interval", options->drive.interval, "s between query frames")->check(CLI::Range(1e-3, 1e4));
   auto seconds = std::make_shared<double>(0.0);
   auto* seconds_option = command->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
                              ->check(CLI::Range(1e-3, 1e6));
-  command->add_option("--resolution-scale", options->drive.resolution_scale,
-                      "render at this fraction of 752x480 (default: the stack's visual_localization.image_scale)")
+  command
+      ->add_option("--resolution-scale", options->drive.resolution_scale,
+                   "render at this fraction of 752x480 (default: the stack's visual_localization.image_scale)")
       ->check(CLI::Range(0.1, 1.0));
   command->add_option("--msaa", options->drive.msaa_samples, "the renderer's anti-aliasing samples (0: none)")
       ->check(CLI::Range(0, 16));
   command->add_option("--prior-sigma", options->prior_sigma, "m: noise of the position prior (truth + noise)")
       ->check(CLI::Range(0.0, 100.0));
   if (name == "retrieval-eval") {
-    command->add_option("--top", options->retrieval_top, "keyframes retrieved per query frame")->check(CLI::Range(1, 1000));
+    command->add_option("--top", options->retrieval_top, "keyframes retrieved per query frame")
+        ->check(CLI::Range(1, 1000));
   }
-  command->add_option("--set", options->stack_overrides, "override a stack.yaml key, e.g. visual_localization.cameras=left");
+  command->add_option("--set", options->stack_overrides,
+                      "override a stack.yaml key, e.g. visual_localization.cameras=left");
   commands.OnRun(command, [=, &commands] {
     options->paths = commands.paths();
     if (seed_option->count() > 0) options->drive.seed = *seed;
@@ -65,18 +70,24 @@ void AddMapCommands(Commands& commands) {
   auto options = std::make_shared<MapBuildOptions>();
   auto seed = std::make_shared<std::uint64_t>(0);
   auto seconds = std::make_shared<double>(0.0);
-  auto* build = map->add_subcommand("build", "render a mapping drive and build a map (Upright-SIFT, Ceres bundle adjustment)");
+  auto* build =
+      map->add_subcommand("build", "render a mapping drive and build a map (Upright-SIFT, Ceres bundle adjustment)");
   build->add_option("plan", options->recipe.plan_path, "drive plan (YAML) of the mapping drive")->required();
-  build->add_option("--out", options->out_dir, "output folder (map.sqlite, map_stats.json, map_top_view.png)")->required();
-  auto* seed_option = build->add_option("--seed", *seed, "seed of the drive and of the survey noise (default: the plan's)");
+  build->add_option("--out", options->out_dir, "output folder (map.sqlite, map_stats.json, map_top_view.png)")
+      ->required();
+  auto* seed_option =
+      build->add_option("--seed", *seed, "seed of the drive and of the survey noise (default: the plan's)");
   auto* seconds_option = build->add_option("--seconds", *seconds, "stop the drive after this much simulated time")
                              ->check(CLI::Range(1e-3, 1e6));
   build->add_option("--survey-position-sigma", options->recipe.survey_position_sigma, "survey noise per axis (m)")
       ->check(CLI::Range(0.0, 1.0));
-  build->add_option("--survey-rotation-sigma-deg", options->recipe.survey_rotation_sigma_deg, "survey rotation noise (deg)")
+  build
+      ->add_option("--survey-rotation-sigma-deg", options->recipe.survey_rotation_sigma_deg,
+                   "survey rotation noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
   auto descriptor = std::make_shared<std::string>();
-  build->add_option("--descriptor", *descriptor, "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)");
+  build->add_option("--descriptor", *descriptor,
+                    "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)");
   commands.OnRun(build, [options, seed, seconds, seed_option, seconds_option, descriptor, &commands] {
     try {
       if (!descriptor->empty()) options->recipe.descriptor = visual_localization::DescriptorFromString(*descriptor);
@@ -97,11 +108,13 @@ void AddMapCommands(Commands& commands) {
   commands.OnRun(ensure, [scenario_path, overrides, &commands] {
     return EnsureScenarioMap(*scenario_path, *overrides, commands.paths());
   });
-  AddEvalCommand(commands, map, "bench", "localize ring frames of a query drive: fixes, errors, time per stage (median) and its histogram",
+  AddEvalCommand(commands, map, "bench",
+                 "localize ring frames of a query drive: fixes, errors, time per stage (median) and its histogram",
                  RunLocalizationBench);
-  AddEvalCommand(commands, map, "retrieval-eval",
-                 "D3.4 Table 4: top-5 retrieved keyframes with >= 50/100/200 verified matches (vocabulary, pose prior, combined)",
-                 RunRetrievalEval);
+  AddEvalCommand(
+      commands, map, "retrieval-eval",
+      "D3.4 Table 4: top-5 retrieved keyframes with >= 50/100/200 verified matches (vocabulary, pose prior, combined)",
+      RunRetrievalEval);
 }
 
 }  // namespace trimbot::scenarios

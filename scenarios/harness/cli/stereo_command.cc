@@ -16,7 +16,8 @@ void AddStereoCommand(Commands& commands) {
   command->add_option("--seed", options->seed, "seed of textures, foliage and image noise");
   command->add_option("--x", options->x, "robot position in the map (m)")->check(CLI::Range(-1e4, 1e4));
   command->add_option("--y", options->y, "robot position in the map (m)")->check(CLI::Range(-1e4, 1e4));
-  command->add_option("--yaw-deg", options->yaw_degrees, "robot heading in the map (degrees)")->check(CLI::Range(-3600.0, 3600.0));
+  command->add_option("--yaw-deg", options->yaw_degrees, "robot heading in the map (degrees)")
+      ->check(CLI::Range(-3600.0, 3600.0));
   command->add_option("--stride", options->stride, "use every n-th pixel for the cloud")->check(CLI::Range(1, 16));
   commands.OnRun(command, [options, &commands] { return RunStereoFrame(*options, commands.paths()); });
 }

@@ -23,7 +23,8 @@ void AddSweep(Commands& commands) {
   auto* trials_option = sweep->add_option("--trials", *trials, "trials per point (default: the scenario's)")
                             ->check(CLI::Range(1, 100000));
   auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
-  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
+  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
+      ->check(CLI::Range(1, 256));
   sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
   auto cluster = AddClusterOptions(sweep);
   commands.OnRun(sweep, [options, trials, seed, trials_option, seed_option, cluster, &commands] {
@@ -43,7 +44,8 @@ void AddTune(Commands& commands) {
   auto seed = std::make_shared<std::uint64_t>(0);
   auto* tune = app.add_subcommand("tune", "tune parameters of a scenario with a derivative-free optimizer (NLopt)");
   tune->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
-  tune->add_option("--space", options->space_path, "parameter space (YAML: parameters with key, min, max, log, integer)")
+  tune->add_option("--space", options->space_path,
+                   "parameter space (YAML: parameters with key, min, max, log, integer)")
       ->required();
   tune->add_option("--objective", options->objective, "batch metric to optimize, e.g. ekf_position_error_mean_m")
       ->required();
@@ -53,7 +55,8 @@ void AddTune(Commands& commands) {
   auto* trials_option = tune->add_option("--trials", *trials, "trials per evaluation (default: the scenario's)")
                             ->check(CLI::Range(1, 100000));
   auto* seed_option = tune->add_option("--seed", *seed, "seed of the tuning trials (the same at every point)");
-  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")->check(CLI::Range(1, 256));
+  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
+      ->check(CLI::Range(1, 256));
   tune->add_option("--out", options->out_dir, "output folder")->required();
   tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
   auto cluster = AddClusterOptions(tune);

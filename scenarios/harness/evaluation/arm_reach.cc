@@ -12,9 +12,9 @@
 namespace trimbot::scenarios {
 namespace {
 
-constexpr double kWorldRadius = 2.5;       // m around the base: the garden the arm could touch
-constexpr long kMaxSamples = 400000;        // joint configurations drawn before giving up
-constexpr double kDistinctPoses = 0.03;     // m between the cutter tips of two poses
+constexpr double kWorldRadius = 2.5;     // m around the base: the garden the arm could touch
+constexpr long kMaxSamples = 400000;     // joint configurations drawn before giving up
+constexpr double kDistinctPoses = 0.03;  // m between the cutter tips of two poses
 
 Eigen::VectorXd JointVector(const std::array<double, messages::kArmJoints>& q) {
   return Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<int>(q.size()));
@@ -39,12 +39,14 @@ robot::CollisionCheckOptions EnvironmentClearance() {
 
 ArmWorld MakeArmWorld(const Scenario& scenario, const sim::Simulator& simulator, const Eigen::Isometry3d& T_map_base) {
   const ArmReach& spec = *scenario.arm_reach;
-  ArmWorld world{robot::CollisionModel(simulator.robot(), simulator.robot().ArmJointNames()), {}, {},
-                 simulator.garden().name};
+  ArmWorld world{
+      robot::CollisionModel(simulator.robot(), simulator.robot().ArmJointNames()), {}, {}, simulator.garden().name};
   const auto& objects = simulator.garden().objects;
-  const auto bush = std::find_if(objects.begin(), objects.end(), [&](const garden::GardenObject& o) { return o.id == spec.bush; });
+  const auto bush =
+      std::find_if(objects.begin(), objects.end(), [&](const garden::GardenObject& o) { return o.id == spec.bush; });
   const std::string what = "arm_reach: bush " + std::to_string(spec.bush) + ": ";
-  if (bush == objects.end()) throw InputError(scenario.source, what + "the garden has no object " + std::to_string(spec.bush));
+  if (bush == objects.end())
+    throw InputError(scenario.source, what + "the garden has no object " + std::to_string(spec.bush));
   if (bush->object_class != garden::ObjectClass::kTopiary && bush->object_class != garden::ObjectClass::kRose) {
     throw InputError(scenario.source, what + "object " + std::to_string(spec.bush) + " is a " +
                                           garden::ToString(bush->object_class) + ", not a bush (topiary or rose)");
@@ -94,7 +96,8 @@ std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const 
     const Eigen::Vector3d tip = T_map_cutter.translation();
     const Eigen::Vector3d to_centre = world.bush_centre - tip;
     if (to_centre.norm() > 1.5) continue;
-    if (std::acos(std::clamp(T_map_cutter.linear().col(2).dot(to_centre.normalized()), -1.0, 1.0)) > spec.max_tilt) continue;
+    if (std::acos(std::clamp(T_map_cutter.linear().col(2).dot(to_centre.normalized()), -1.0, 1.0)) > spec.max_tilt)
+      continue;
     double surface = 1e9;
     for (int index : world.bush) surface = std::min(surface, world.model.environment().DistanceTo(index, tip));
     if (surface < spec.distance_min || surface > spec.distance_max) continue;
@@ -206,11 +209,12 @@ void ArmReachEvaluator::Finish(TrialResult* result) const {
 void ArmReachEvaluator::WriteFiles(const std::string& dir) const {
   std::ostringstream csv;
   csv << "goal,x,y,z,stack_reached,position_error_m,orientation_error_deg,ik_solutions,free_goals,path_length_rad,"
-         "cutter_path_length_m,motion_seconds,tracking_error_max_rad,min_clearance_m,witness_clearance_m,contacts,failure\n";
+         "cutter_path_length_m,motion_seconds,tracking_error_max_rad,min_clearance_m,witness_clearance_m,contacts,"
+         "failure\n";
   for (const ArmGoalOutcome& o : outcomes_) {
-    csv << o.goal << ',' << o.x << ',' << o.y << ',' << o.z << ',' << o.stack_reached << ',' << o.position_error_m << ','
-        << o.orientation_error_deg << ',' << o.ik_solutions << ',' << o.free_goals << ',' << o.path_length_rad << ','
-        << o.cutter_path_length_m << ',' << o.motion_seconds << ',' << o.tracking_error_max_rad << ','
+    csv << o.goal << ',' << o.x << ',' << o.y << ',' << o.z << ',' << o.stack_reached << ',' << o.position_error_m
+        << ',' << o.orientation_error_deg << ',' << o.ik_solutions << ',' << o.free_goals << ',' << o.path_length_rad
+        << ',' << o.cutter_path_length_m << ',' << o.motion_seconds << ',' << o.tracking_error_max_rad << ','
         << o.min_clearance_m << ',' << o.witness_clearance_m << ',' << o.contacts << ",\"" << o.failure << "\"\n";
   }
   WriteFileAtomically(dir + "/arm_goals.csv", csv.str());

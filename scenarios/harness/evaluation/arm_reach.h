@@ -23,8 +23,8 @@ namespace trimbot::scenarios {
 
 struct ArmReachPose {
   Eigen::Isometry3d cutter_base = Eigen::Isometry3d::Identity();  // goal: the cutter frame in base_link
-  Eigen::VectorXd witness;        // joint positions that reach it without collision
-  double witness_clearance = 0.0; // m
+  Eigen::VectorXd witness;                                        // joint positions that reach it without collision
+  double witness_clearance = 0.0;                                 // m
   double surface_distance = 0.0;  // m: the cutter's tip from the bush's collision surface
 };
 
@@ -32,9 +32,9 @@ struct ArmReachPose {
 // them, and the ground, in the map frame; `bush` indexes the bush's hull among them.
 struct ArmWorld {
   robot::CollisionModel model;
-  std::vector<int> bush;           // environment indices of the bush's hulls
+  std::vector<int> bush;  // environment indices of the bush's hulls
   Eigen::Vector3d bush_centre = Eigen::Vector3d::Zero();
-  std::string garden;              // its name
+  std::string garden;  // its name
 };
 
 // Throws InputError naming the scenario when the bush is not a bush of the garden.
@@ -65,7 +65,7 @@ class ArmReachEvaluator : public Observer {
   std::vector<ArmGoalOutcome> outcomes_;
   std::set<std::pair<std::string, std::string>> touching_;  // arm contacts in the last step
   int contacts_ = 0;
-  int current_ = 0;   // the goal the stack works on
+  int current_ = 0;  // the goal the stack works on
   long steps_ = 0;
   double min_clearance_ = 1e9;
   std::vector<double> planning_seconds_;

@@ -5,8 +5,8 @@
 #include <iomanip>
 #include <numeric>
 #include <optional>
-#include <tuple>
 #include <sstream>
+#include <tuple>
 
 #include "trimbot/common/input_error.h"
 
@@ -46,7 +46,7 @@ MetricComparison CompareValues(const std::string& metric, const std::string& uni
   m.candidate = Mean(b);
   m.delta = m.candidate - m.baseline;
   m.delta_interval = BootstrapDifferenceInterval(a, b);
-  m.p_worse = MannWhitneyGreaterP(a, b);   // higher is worse for every such metric
+  m.p_worse = MannWhitneyGreaterP(a, b);  // higher is worse for every such metric
   m.p_better = MannWhitneyGreaterP(b, a);
   return m;
 }
@@ -116,8 +116,10 @@ Comparison CompareBatches(const json& baseline, const std::string& baseline_file
   }
   c.alpha_per_metric = alpha / static_cast<double>(c.metrics.size());
   for (auto& m : c.metrics) {
-    if (m.p_worse < c.alpha_per_metric) m.verdict = "regressed";
-    else if (m.p_better < c.alpha_per_metric) m.verdict = "improved";
+    if (m.p_worse < c.alpha_per_metric)
+      m.verdict = "regressed";
+    else if (m.p_better < c.alpha_per_metric)
+      m.verdict = "improved";
     c.regressed = c.regressed || m.verdict == "regressed";
   }
   const double from = c.metrics.front().baseline;
@@ -133,12 +135,13 @@ Comparison CompareBatches(const json& baseline, const std::string& baseline_file
 std::vector<MetricEstimate> BatchEstimates(const json& summary) {
   std::vector<MetricEstimate> estimates;
   const int n = summary.value("trials_planned", 0), successes = Successes(summary);
-  estimates.push_back({"success_rate", "", n > 0 ? static_cast<double>(successes) / n : 0.0,
-                       WilsonInterval(successes, n), n});
+  estimates.push_back(
+      {"success_rate", "", n > 0 ? static_cast<double>(successes) / n : 0.0, WilsonInterval(successes, n), n});
   for (const auto& metric : PerTrialMetricTable()) {
     const auto values = PerTrial(summary, metric.extract);
     const double mean = values.empty() ? std::nan("") : Mean(values);
-    estimates.push_back({metric.name, metric.unit, mean, BootstrapMeanInterval(values), static_cast<int>(values.size())});
+    estimates.push_back(
+        {metric.name, metric.unit, mean, BootstrapMeanInterval(values), static_cast<int>(values.size())});
   }
   return estimates;
 }
@@ -146,27 +149,41 @@ std::vector<MetricEstimate> BatchEstimates(const json& summary) {
 json ToJson(const Comparison& c) {
   json metrics = json::array();
   for (const auto& m : c.metrics) {
-    metrics.push_back({{"metric", m.metric}, {"unit", m.unit}, {"test", m.test}, {"baseline", m.baseline},
-                       {"candidate", m.candidate}, {"delta", m.delta},
-                       {"delta_95", {m.delta_interval.low, m.delta_interval.high}}, {"p_worse", m.p_worse},
-                       {"p_better", m.p_better}, {"verdict", m.verdict}});
+    metrics.push_back({{"metric", m.metric},
+                       {"unit", m.unit},
+                       {"test", m.test},
+                       {"baseline", m.baseline},
+                       {"candidate", m.candidate},
+                       {"delta", m.delta},
+                       {"delta_95", {m.delta_interval.low, m.delta_interval.high}},
+                       {"p_worse", m.p_worse},
+                       {"p_better", m.p_better},
+                       {"verdict", m.verdict}});
   }
   json power = json::array();
   for (const auto& d : c.power) {
-    power.push_back({{"success_rate_from", d.from}, {"success_rate_to", d.to}, {"trials_needed", d.trials_needed},
+    power.push_back({{"success_rate_from", d.from},
+                     {"success_rate_to", d.to},
+                     {"trials_needed", d.trials_needed},
                      {"power_with_these_trials", d.power_now}});
   }
-  return {{"scenario", c.scenario}, {"baseline_trials", c.baseline_trials}, {"candidate_trials", c.candidate_trials},
-          {"alpha", c.alpha}, {"alpha_per_metric", c.alpha_per_metric}, {"metrics", metrics},
-          {"power", power}, {"verdict", c.regressed ? "regressed" : "no regression"}};
+  return {{"scenario", c.scenario},
+          {"baseline_trials", c.baseline_trials},
+          {"candidate_trials", c.candidate_trials},
+          {"alpha", c.alpha},
+          {"alpha_per_metric", c.alpha_per_metric},
+          {"metrics", metrics},
+          {"power", power},
+          {"verdict", c.regressed ? "regressed" : "no regression"}};
 }
 
 std::string ToMarkdown(const Comparison& c) {
   std::ostringstream md;
   md << std::setprecision(4);
   md << "### " << c.scenario << ": " << (c.regressed ? "REGRESSED" : "no regression") << "\n\n"
-     << "Baseline " << c.baseline_trials << " trials, candidate " << c.candidate_trials << " trials; one-sided tests at "
-     << c.alpha << " split over " << c.metrics.size() << " metrics (" << c.alpha_per_metric << " each).\n\n"
+     << "Baseline " << c.baseline_trials << " trials, candidate " << c.candidate_trials
+     << " trials; one-sided tests at " << c.alpha << " split over " << c.metrics.size() << " metrics ("
+     << c.alpha_per_metric << " each).\n\n"
      << "| metric | baseline | candidate | delta (95 % interval) | p worse | p better | verdict |\n"
      << "|---|---|---|---|---|---|---|\n";
   for (const auto& m : c.metrics) {
@@ -176,8 +193,9 @@ std::string ToMarkdown(const Comparison& c) {
   }
   md << "\nTrials per side to detect a drop of the success rate (80 % power):";
   for (const auto& d : c.power) {
-    md << " " << d.from << " -> " << d.to << ": " << (d.trials_needed < 0 ? std::string(">200") : std::to_string(d.trials_needed))
-       << " (power now " << std::setprecision(2) << d.power_now << std::setprecision(4) << ");";
+    md << " " << d.from << " -> " << d.to << ": "
+       << (d.trials_needed < 0 ? std::string(">200") : std::to_string(d.trials_needed)) << " (power now "
+       << std::setprecision(2) << d.power_now << std::setprecision(4) << ");";
   }
   md << "\n";
   return md.str();

@@ -18,9 +18,9 @@ struct MetricComparison {
   std::string unit;
   std::string test;
   double baseline = 0.0, candidate = 0.0, delta = 0.0;  // means (rates for success_rate)
-  Interval delta_interval;                               // 95 %
-  double p_worse = 1.0, p_better = 1.0;                  // one-sided p-values
-  std::string verdict = "no evidence";                   // regressed | improved | no evidence
+  Interval delta_interval;                              // 95 %
+  double p_worse = 1.0, p_better = 1.0;                 // one-sided p-values
+  std::string verdict = "no evidence";                  // regressed | improved | no evidence
 };
 
 struct DetectableDrop {

@@ -14,9 +14,9 @@
 namespace trimbot::scenarios {
 namespace {
 
-constexpr double kResolutionScale = 0.5;   // 376 x 240: near the Kinect's 320 x 240 depth
-constexpr double kLateralPixels = 0.8;      // px, Kinect lateral noise
-constexpr int kCamera = 0;                  // cam0 looks along base_link's x
+constexpr double kResolutionScale = 0.5;  // 376 x 240: near the Kinect's 320 x 240 depth
+constexpr double kLateralPixels = 0.8;    // px, Kinect lateral noise
+constexpr int kCamera = 0;                // cam0 looks along base_link's x
 
 // Portable draws (common/random.h) from the set's own stream.
 class Draws {
@@ -45,7 +45,8 @@ perception::PointCloud CloudFromDepth(const cv::Mat& depth, const robot::Pinhole
       const double lateral = kLateralPixels * z / camera.fx;
       const double noisy_z = z + axial * draws.Normal();
       const double noise_x = draws.Normal(), noise_y = draws.Normal();  // in order, whatever the compiler
-      const Eigen::Vector3d point(ray.x() * noisy_z + lateral * noise_x, ray.y() * noisy_z + lateral * noise_y, noisy_z);
+      const Eigen::Vector3d point(ray.x() * noisy_z + lateral * noise_x, ray.y() * noisy_z + lateral * noise_y,
+                                  noisy_z);
       const Eigen::Vector2d in_map = (T_map_camera * point).head<2>();
       if (options.crop_margin >= 0.0 && (in_map - object.position).norm() > crop_radius) continue;
       cloud.Add(point, Eigen::Vector3d(lateral * lateral, lateral * lateral, axial * axial).asDiagonal());
@@ -127,7 +128,7 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
     pair.x = std::move(clouds[0]);
     pair.y = std::move(clouds[1]);
     pair.truth = T_map_camera[0].inverse() * T_map_camera[1];  // x = truth * y
-    pair.relative_covariances = false;  // the noise model's variances, m^2
+    pair.relative_covariances = false;                         // the noise model's variances, m^2
     pairs.push_back(std::move(pair));
   }
   return pairs;

@@ -17,10 +17,10 @@ struct RegistrationSetOptions {
   std::string garden = "test_lawn";
   int pairs = 50;
   std::uint64_t seed = 1;
-  double min_distance = 1.2, max_distance = 2.2;  // m from the object's centre to the camera
+  double min_distance = 1.2, max_distance = 2.2;    // m from the object's centre to the camera
   double min_turn_deg = 10.0, max_turn_deg = 40.0;  // between the two viewpoints, about the object
-  int stride = 4;                 // every stride-th pixel in each direction
-  double max_depth = 4.0;         // m: farther pixels are left out (the Kinect's range)
+  int stride = 4;                                   // every stride-th pixel in each direction
+  double max_depth = 4.0;                           // m: farther pixels are left out (the Kinect's range)
   // Each cloud keeps the object and the ground around it, as the DUGMA data set's clouds do (each
   // a ~1.4 m square around a bush): points horizontally within the object's half-diagonal plus this
   // margin of its centre. < 0 keeps the whole view (background, far ground, other objects).

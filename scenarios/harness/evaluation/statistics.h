@@ -24,8 +24,8 @@ Interval WilsonInterval(int successes, int n, double z = 1.959964);
 // Percentile bootstrap interval (95 %) of the mean of `samples` (empty -> [0, 0]).
 Interval BootstrapMeanInterval(const std::vector<double>& samples, std::uint64_t seed = 1, int resamples = 2000);
 // Percentile bootstrap interval (95 %) of mean(b) - mean(a).
-Interval BootstrapDifferenceInterval(const std::vector<double>& a, const std::vector<double>& b,
-                                     std::uint64_t seed = 1, int resamples = 2000);
+Interval BootstrapDifferenceInterval(const std::vector<double>& a, const std::vector<double>& b, std::uint64_t seed = 1,
+                                     int resamples = 2000);
 
 // One-sided Fisher exact test that the success rate of b (sb of nb) is lower than that of a
 // (sa of na): P(X_b <= sb) under the hypergeometric null with the margins fixed.

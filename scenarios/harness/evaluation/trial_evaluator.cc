@@ -39,12 +39,17 @@ std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals) {
 
 TrialEvaluator::TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCriteria& criteria,
                                double fix_history_seconds)
-    : truths_(goals), criteria_(criteria), fix_history_seconds_(fix_history_seconds), goals_(UnreachedGoals(goals)),
-      bush_status_(goals.size()), goal_planned_(goals.size(), false) {}
+    : truths_(goals),
+      criteria_(criteria),
+      fix_history_seconds_(fix_history_seconds),
+      goals_(UnreachedGoals(goals)),
+      bush_status_(goals.size()),
+      goal_planned_(goals.size(), false) {}
 
 Eigen::Vector2d TrialEvaluator::TrueBushDistanceBearing(const PlanarPose& truth, int goal) const {
   const Eigen::Vector2d from_arm =
-      stack::IntoFrame({truth.x, truth.y, truth.yaw}, truths_[static_cast<std::size_t>(goal)].position) - criteria_.arm_axis;
+      stack::IntoFrame({truth.x, truth.y, truth.yaw}, truths_[static_cast<std::size_t>(goal)].position) -
+      criteria_.arm_axis;
   return {from_arm.norm(), std::atan2(from_arm.y(), from_arm.x())};
 }
 
@@ -67,7 +72,8 @@ void TrialEvaluator::ObserveBushSightings(const StepView& step) {
   }
 }
 
-void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const PlanarPose& truth, GoalResult* goal) const {
+void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const PlanarPose& truth,
+                                   GoalResult* goal) const {
   const std::optional<stack::BushApproachStatus>& status = bush_status_[static_cast<std::size_t>(event.goal)];
   if (!status) return;  // the stack never reported approaching it: not reached
   const Eigen::Vector2d actual = TrueBushDistanceBearing(truth, event.goal);
@@ -103,7 +109,8 @@ void TrialEvaluator::Observe(const StepView& step) {
   }
   // Fixes of the simulated fixture, and the stack's own visual fixes as they reach its EKF.
   std::vector<messages::PoseFix> fixes = step.pose_fixes;
-  if (step.telemetry != nullptr) fixes.insert(fixes.end(), step.telemetry->visual_fixes.begin(), step.telemetry->visual_fixes.end());
+  if (step.telemetry != nullptr)
+    fixes.insert(fixes.end(), step.telemetry->visual_fixes.begin(), step.telemetry->visual_fixes.end());
   for (const auto& fix : fixes) {
     fix_stamps_.push_back(fix.stamp);
     fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
@@ -118,7 +125,8 @@ void TrialEvaluator::Observe(const StepView& step) {
   ObserveBushSightings(step);
   ObserveEvents(step, truth);
   // After the events: a bush goal is judged on the status the stack reported up to its arrival.
-  if (const auto& bush = step.telemetry->bush; bush && bush->goal >= 0 && bush->goal < static_cast<int>(bush_status_.size())) {
+  if (const auto& bush = step.telemetry->bush;
+      bush && bush->goal >= 0 && bush->goal < static_cast<int>(bush_status_.size())) {
     bush_status_[static_cast<std::size_t>(bush->goal)] = bush;
   }
 }
@@ -146,8 +154,8 @@ void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const E
   world_ = world;
   // The outline's perimeter every ~2 cm.
   outline_.clear();
-  const Eigen::Vector2d corners[4] = {outline_min, {outline_max.x(), outline_min.y()}, outline_max,
-                                      {outline_min.x(), outline_max.y()}};
+  const Eigen::Vector2d corners[4] = {
+      outline_min, {outline_max.x(), outline_min.y()}, outline_max, {outline_min.x(), outline_max.y()}};
   for (int side = 0; side < 4; ++side) {
     const Eigen::Vector2d a = corners[side], b = corners[(side + 1) % 4];
     const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.02)));
@@ -178,8 +186,8 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
   using Type = stack::NavigationEvent::Type;
   for (const auto& event : step.telemetry->events) {
     std::ostringstream line;
-    line << std::fixed << std::setprecision(3) << event.stamp << ',' << stack::ToString(event.type) << ','
-         << event.goal << ',' << event.detail << '\n';
+    line << std::fixed << std::setprecision(3) << event.stamp << ',' << stack::ToString(event.type) << ',' << event.goal
+         << ',' << event.detail << '\n';
     events_csv_ += line.str();
     if (event.type == Type::kPlanned) {
       ++plans_;

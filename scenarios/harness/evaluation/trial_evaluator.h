@@ -27,8 +27,8 @@ std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals);
 
 // When a goal counts as reached (ground truth at the robot's declared arrival).
 struct GoalCriteria {
-  double tolerance = 0.3;              // m from a point goal
-  double bush_distance = 0.03;         // m from the standoff the stack aimed at (arm's axis to the centre)
+  double tolerance = 0.3;                    // m from a point goal
+  double bush_distance = 0.03;               // m from the standoff the stack aimed at (arm's axis to the centre)
   double bush_bearing = 3.0 * M_PI / 180.0;  // rad from the bearing it aimed at
   Eigen::Vector2d arm_axis = Eigen::Vector2d::Zero();  // base_link: where bush distances are measured from
 };
@@ -75,7 +75,7 @@ class TrialEvaluator : public Observer {
   EstimateErrors ekf_{"ekf", {}, {}}, odometry_{"wheel_odometry", {}, {}}, fixes_{"pose_fixes", {}, {}};
   std::string truth_tum_, ekf_tum_, odometry_tum_, fixes_tum_;
   std::string events_csv_ = "t,event,goal,detail\n";
-  std::deque<PlanarPose> truth_history_;    // the last seconds, to judge late fixes at their stamps
+  std::deque<PlanarPose> truth_history_;  // the last seconds, to judge late fixes at their stamps
   bool have_previous_ = false;
   PlanarPose previous_;
   double path_length_ = 0.0;

@@ -78,8 +78,13 @@ void from_json(const nlohmann::json& j, GoalResult& g) {
 }
 
 void to_json(nlohmann::json& j, const BushFrame& f) {
-  j = {{"t", f.t}, {"goal", f.goal}, {"true_distance_m", f.true_distance_m}, {"true_bearing_deg", f.true_bearing_deg},
-       {"found", f.found}, {"distance_error_m", f.distance_error_m}, {"bearing_error_deg", f.bearing_error_deg}};
+  j = {{"t", f.t},
+       {"goal", f.goal},
+       {"true_distance_m", f.true_distance_m},
+       {"true_bearing_deg", f.true_bearing_deg},
+       {"found", f.found},
+       {"distance_error_m", f.distance_error_m},
+       {"bearing_error_deg", f.bearing_error_deg}};
 }
 
 void from_json(const nlohmann::json& j, BushFrame& f) {
@@ -147,11 +152,8 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
 }
 
 void to_json(nlohmann::json& j, const CriterionResult& c) {
-  j = {{"name", c.name},
-       {"comparison", c.comparison},
-       {"expected", c.expected},
-       {"actual", c.actual},
-       {"pass", c.pass}};
+  j = {
+      {"name", c.name}, {"comparison", c.comparison}, {"expected", c.expected}, {"actual", c.actual}, {"pass", c.pass}};
 }
 
 void to_json(nlohmann::json& j, const BatchSummary& b) {
@@ -227,7 +229,8 @@ void AddArmMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metri
       ++goals;
       reached += goal.reached ? 1 : 0;
       tracking = std::max(tracking, goal.tracking_error_max_rad);
-      if (goal.min_clearance_m >= 0.0) clearance = std::min(clearance.value_or(goal.min_clearance_m), goal.min_clearance_m);
+      if (goal.min_clearance_m >= 0.0)
+        clearance = std::min(clearance.value_or(goal.min_clearance_m), goal.min_clearance_m);
       if (!goal.stack_reached) continue;
       position.push_back(goal.position_error_m);
       orientation.push_back(goal.orientation_error_deg);
@@ -273,7 +276,8 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
         std::count_if(trial.goals.begin(), trial.goals.end(), [](const GoalResult& g) { return g.reached; }));
     simulated_seconds += trial.simulated_seconds;
     path_length_m += trial.path_length_m;
-    if (trial.min_clearance_m) min_clearance_m = std::min(min_clearance_m.value_or(*trial.min_clearance_m), *trial.min_clearance_m);
+    if (trial.min_clearance_m)
+      min_clearance_m = std::min(min_clearance_m.value_or(*trial.min_clearance_m), *trial.min_clearance_m);
     if (trial.localization_rate >= 0.0) localization_rates.push_back(trial.localization_rate);
     for (const EstimateErrors& estimate : trial.estimates) {
       if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
@@ -284,7 +288,9 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
     }
   }
 
-  const auto ratio = [](double numerator, double denominator) { return denominator > 0 ? numerator / denominator : 0.0; };
+  const auto ratio = [](double numerator, double denominator) {
+    return denominator > 0 ? numerator / denominator : 0.0;
+  };
   const double ran = static_cast<double>(trials.size());
   nlohmann::json metrics = nlohmann::json::object();
   metrics["success_rate"] = ratio(successes, planned);

@@ -21,26 +21,26 @@ struct ErrorStats {
 // the estimate's own stamps (fixes) or at the evaluation rate (filters).
 struct EstimateErrors {
   std::string name;
-  std::vector<double> position_m;    // samples, metres
-  std::vector<double> heading_deg;   // samples, degrees (absolute)
+  std::vector<double> position_m;   // samples, metres
+  std::vector<double> heading_deg;  // samples, degrees (absolute)
   ErrorStats position() const { return ErrorStats::From(position_m); }
   ErrorStats heading() const { return ErrorStats::From(heading_deg); }
 };
 
 struct GoalResult {
-  double x = 0.0, y = 0.0;        // goal in the map frame
-  bool reached = false;           // the robot declared arrival and was within tolerance (ground truth)
-  double arrival_time = -1.0;     // s of simulated time since the trial's start, -1 if never
-  double final_error_m = -1.0;    // ground-truth distance to the goal when the robot declared arrival
+  double x = 0.0, y = 0.0;      // goal in the map frame
+  bool reached = false;         // the robot declared arrival and was within tolerance (ground truth)
+  double arrival_time = -1.0;   // s of simulated time since the trial's start, -1 if never
+  double final_error_m = -1.0;  // ground-truth distance to the goal when the robot declared arrival
   // A goal inside an obstacle's clearance is moved by the robot to the nearest point it can arrive
   // at (within its goal_search_radius): arrival is judged there, and the move is reported.
-  double adjusted_by_m = 0.0;     // 0: the goal as asked
+  double adjusted_by_m = 0.0;         // 0: the goal as asked
   double used_x = 0.0, used_y = 0.0;  // the goal navigated to (as asked, or adjusted)
   // A bush goal (approach_bush): the arm's axis at the robot's true pose against the bush's true
   // centre when the robot declared arrival (reached: both errors within the bush tolerance).
-  int bush = 0;                             // garden object id; 0: a point goal
-  double bush_distance_error_m = 0.0;       // true distance - the standoff the stack aimed at
-  double bush_bearing_error_deg = 0.0;      // true bearing - the bearing it aimed at
+  int bush = 0;                                  // garden object id; 0: a point goal
+  double bush_distance_error_m = 0.0;            // true distance - the standoff the stack aimed at
+  double bush_bearing_error_deg = 0.0;           // true bearing - the bearing it aimed at
   double bush_estimate_distance_error_m = 0.0;   // the stack's tracked distance - the true one
   double bush_estimate_bearing_error_deg = 0.0;  // the stack's tracked bearing - the true one
 };
@@ -49,7 +49,7 @@ struct GoalResult {
 struct BushFrame {
   double t = 0.0;
   int goal = 0;
-  double true_distance_m = 0.0;   // arm's axis to the bush's true centre
+  double true_distance_m = 0.0;  // arm's axis to the bush's true centre
   double true_bearing_deg = 0.0;
   bool found = false;             // the stack's fit gave a centre (errors below are then set)
   double distance_error_m = 0.0;  // estimated - true
@@ -60,15 +60,15 @@ struct BushFrame {
 // from the simulator, MuJoCo's contacts, the arm's clearance from the garden as it collides).
 struct ArmGoalOutcome {
   int goal = 0;
-  double x = 0.0, y = 0.0, z = 0.0;     // the goal's cutter position, base_link
-  bool reached = false;                 // the stack reported it reached, the true errors within tolerance, no contact
-  bool stack_reached = false;           // the stack reported it reached
-  std::string failure;                  // the stack's reason when it did not
-  double position_error_m = -1.0;       // true cutter - goal when the stack finished the goal
+  double x = 0.0, y = 0.0, z = 0.0;  // the goal's cutter position, base_link
+  bool reached = false;              // the stack reported it reached, the true errors within tolerance, no contact
+  bool stack_reached = false;        // the stack reported it reached
+  std::string failure;               // the stack's reason when it did not
+  double position_error_m = -1.0;    // true cutter - goal when the stack finished the goal
   double orientation_error_deg = -1.0;
-  double witness_clearance_m = 0.0;     // of the generator's joint configuration for the pose
+  double witness_clearance_m = 0.0;  // of the generator's joint configuration for the pose
   int ik_solutions = 0;
-  int free_goals = 0;                   // collision-free solutions, as the stack perceived its surroundings
+  int free_goals = 0;  // collision-free solutions, as the stack perceived its surroundings
   double path_length_rad = 0.0;
   double cutter_path_length_m = 0.0;
   double motion_seconds = 0.0;
@@ -89,24 +89,24 @@ struct TrialResult {
   bool success = false;            // every goal reached, no collision
   std::vector<GoalResult> goals;
   double simulated_seconds = 0.0;
-  double wall_seconds = 0.0;       // not in result.json / summary.json (see timing.json): not reproducible
-  double path_length_m = 0.0;      // ground truth
-  int collisions = 0;              // separate contact events with garden objects
+  double wall_seconds = 0.0;   // not in result.json / summary.json (see timing.json): not reproducible
+  double path_length_m = 0.0;  // ground truth
+  int collisions = 0;          // separate contact events with garden objects
   double contact_seconds = 0.0;
   // Smallest distance between the base's outline (URDF collision geometry of the base and wheels)
   // at its true pose and the garden as it is (m, negative: overlap); absent when not measured.
   std::optional<double> min_clearance_m;
   int replans = 0;
-  int recoveries = 0;              // obstacle stops followed by a recovery manoeuvre
+  int recoveries = 0;  // obstacle stops followed by a recovery manoeuvre
   int fixes_accepted = 0, fixes_rejected = 0, relocalizations = 0;
   // Share of the 10 Hz evaluation samples, from the first pose fix on, with a fix stamped within
   // 0.5 s (Table 2's last column of D3.4); -1 when no fix arrived.
   double localization_rate = -1.0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
-  std::vector<BushFrame> bush_frames;  // bush goals' sightings
-  std::vector<ArmGoalOutcome> arm_goals;  // arm_reach trials
-  int arm_contacts = 0;                   // arm contact events (MuJoCo), all goals
+  std::vector<BushFrame> bush_frames;        // bush goals' sightings
+  std::vector<ArmGoalOutcome> arm_goals;     // arm_reach trials
+  int arm_contacts = 0;                      // arm contact events (MuJoCo), all goals
   std::vector<double> arm_planning_seconds;  // wall clock per plan: timing.json only, not reproducible
 };
 
@@ -120,14 +120,14 @@ struct CriterionResult {
 };
 
 struct BatchSummary {
-  std::string scenario;        // scenario name
+  std::string scenario;  // scenario name
   std::string scenario_file;
   std::vector<std::string> overrides;  // --set key=value the batch ran with
-  std::uint64_t seed = 0;      // batch seed; trial seeds are in the trials
+  std::uint64_t seed = 0;              // batch seed; trial seeds are in the trials
   int trials_planned = 0;
   std::vector<TrialResult> trials;
   // Aggregates over all trials (samples pooled over trials).
-  nlohmann::json metrics;      // name -> number; see ComputeBatchMetrics
+  nlohmann::json metrics;  // name -> number; see ComputeBatchMetrics
   std::vector<CriterionResult> criteria;
   bool pass = false;
 };
@@ -146,8 +146,8 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 
 // Batch metrics from the trials: success_rate (trials with success / trials planned; a trial that
 // never ran counts as failed), goal_success_rate, trials_completed, collisions, recoveries,
-// mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), and per estimate E
-// (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
+// mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), and per estimate
+// E (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
 // E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples);
 // with bush goals: bush_goals, bush_{distance,bearing}_error_{mean,max} (final pose, absolute,
 // m / deg), bush_estimate_{distance,bearing}_error_{mean,max} (the stack's final estimate), and

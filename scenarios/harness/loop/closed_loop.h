@@ -23,10 +23,10 @@ struct StepView {
   double time = 0.0;
   double timestep = 0.0;
   const sim::SensorOutputs& sensors;
-  const std::vector<messages::PoseFix>& pose_fixes;   // delivered to the pilot this step
+  const std::vector<messages::PoseFix>& pose_fixes;  // delivered to the pilot this step
   const sim::GroundTruth& truth;
   const messages::RobotCommands& commands;
-  const stack::Telemetry* telemetry;                  // null when no robot software runs
+  const stack::Telemetry* telemetry;  // null when no robot software runs
 };
 
 // What commands the robot in the loop (its pilot): the robot software, or an open-loop player.
@@ -51,7 +51,7 @@ class Observer {
 };
 
 struct LoopOptions {
-  double time_limit = 0.0;                 // s of simulated time
+  double time_limit = 0.0;  // s of simulated time
   // The simulator renders only the cameras the pilot asks for, when it asks (it must have
   // been configured with render_cameras and without cameras_on_schedule).
   bool render_on_demand = false;
@@ -59,7 +59,7 @@ struct LoopOptions {
   // exposed in this step, at the simulator's configured resolution; merged with the pilot's.
   std::function<bool(const sim::GroundTruth&)> ring_demand;
   SimulatedPoseFixes* pose_fixes = nullptr;  // test fixture, when the stack is configured for it
-  std::function<void(double)> progress;    // called about once per simulated second
+  std::function<void(double)> progress;      // called about once per simulated second
 };
 
 // Steps until the pilot has finished or the time limit; returns whether it finished.

@@ -12,9 +12,9 @@
 namespace trimbot::scenarios {
 
 struct DriveSegment {
-  double duration = 0.0;  // s
-  double linear = 0.0;    // m/s
-  double angular = 0.0;   // rad/s
+  double duration = 0.0;                     // s
+  double linear = 0.0;                       // m/s
+  double angular = 0.0;                      // rad/s
   std::optional<std::array<double, 6>> arm;  // joint position target, rad
   bool cutter = false;
 };

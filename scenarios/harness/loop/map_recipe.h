@@ -11,10 +11,10 @@ namespace trimbot::scenarios {
 // map file (`visual_map: {mapping_drive: PLAN}`); the map is then built on first use and cached
 // (runner/map_cache.h).
 struct MapRecipe {
-  std::string plan_path;                 // the mapping drive: a drive plan, or a scenario with goals
-  std::optional<std::uint64_t> seed;     // the drive's (and the survey noise's) seed; default: the plan's
-  std::optional<double> seconds;         // stop the drive early
-  double survey_position_sigma = 0.02;   // m per axis
+  std::string plan_path;                // the mapping drive: a drive plan, or a scenario with goals
+  std::optional<std::uint64_t> seed;    // the drive's (and the survey noise's) seed; default: the plan's
+  std::optional<double> seconds;        // stop the drive early
+  double survey_position_sigma = 0.02;  // m per axis
   double survey_rotation_sigma_deg = 0.5;
   // Upright-SIFT or SIFT; default: the stack's (stack.yaml, with the scenario's stack section).
   std::optional<visual_localization::Descriptor> descriptor;

@@ -12,7 +12,7 @@ void FeedStack(stack::RobotStack& stack, const sim::SensorOutputs& sensors,
 }
 
 messages::RobotCommands StackPilot::Step(double time, const sim::SensorOutputs& sensors,
-                                              const std::vector<messages::PoseFix>& pose_fixes) {
+                                         const std::vector<messages::PoseFix>& pose_fixes) {
   FeedStack(stack_, sensors, pose_fixes);
   return stack_.Update(time);
 }

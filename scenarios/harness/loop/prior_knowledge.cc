@@ -27,7 +27,8 @@ garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey,
     const auto it = std::find_if(surveyed.objects.begin(), surveyed.objects.end(),
                                  [id](const garden::GardenObject& o) { return o.id == id; });
     if (it == surveyed.objects.end()) {
-      throw InputError(scenario_file, "survey.unmapped: garden '" + built.name + "' has no object " + std::to_string(id));
+      throw InputError(scenario_file,
+                       "survey.unmapped: garden '" + built.name + "' has no object " + std::to_string(id));
     }
     surveyed.objects.erase(it);
   }
@@ -70,7 +71,7 @@ std::string ApproachBush(int id) { return "goals: approach_bush " + std::to_stri
 
 perception::BushShape ShapeOf(const garden::GardenObject& object) {
   perception::BushShape shape;
-  shape.kind = object.shape == garden::Shape::kEllipsoid ? perception::BushShape::Kind::kEllipsoid
+  shape.kind = object.shape == garden::Shape::kEllipsoid  ? perception::BushShape::Kind::kEllipsoid
                : object.shape == garden::Shape::kCylinder ? perception::BushShape::Kind::kCylinder
                                                           : perception::BushShape::Kind::kBox;
   shape.size = object.size;
@@ -142,15 +143,18 @@ std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths
 stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths) {
   const stack::StackParameters defaults = stack::StackParameters::Load(paths.robot_files().stack_parameters);
   const stack::StackParameters parameters = scenario.stack ? defaults.Overridden(*scenario.stack) : defaults;
-  if (scenario.simulated_pose_fixes_given && parameters.localization != stack::LocalizationSource::kSimulatedPoseFixes) {
-    throw InputError(scenario.source, std::string("simulated_pose_fixes: settings given, but the stack's localization is '") +
-                                          stack::ToString(parameters.localization) +
-                                          "' (set stack: {localization: simulated_pose_fixes} to use them)");
+  if (scenario.simulated_pose_fixes_given &&
+      parameters.localization != stack::LocalizationSource::kSimulatedPoseFixes) {
+    throw InputError(scenario.source,
+                     std::string("simulated_pose_fixes: settings given, but the stack's localization is '") +
+                         stack::ToString(parameters.localization) +
+                         "' (set stack: {localization: simulated_pose_fixes} to use them)");
   }
   if (parameters.localization == stack::LocalizationSource::kVisual && scenario.visual_map.empty() &&
       !scenario.visual_map_recipe) {
-    throw InputError(scenario.source, "the stack's localization is 'visual', but the scenario names no visual_map "
-                                      "(a map file, or {mapping_drive: PLAN} to build one on first use)");
+    throw InputError(scenario.source,
+                     "the stack's localization is 'visual', but the scenario names no visual_map "
+                     "(a map file, or {mapping_drive: PLAN} to build one on first use)");
   }
   return parameters;
 }

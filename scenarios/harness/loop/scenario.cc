@@ -118,7 +118,8 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     map.RejectUnknownKeys();
   }
   if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"));
-  for (const YamlMap& goal : root.Has("goals") || !root.Has("arm_reach") ? root.MapList("goals") : std::vector<YamlMap>{}) {
+  for (const YamlMap& goal :
+       root.Has("goals") || !root.Has("arm_reach") ? root.MapList("goals") : std::vector<YamlMap>{}) {
     ScenarioGoal g;
     if (goal.Has("approach_bush")) {
       g.bush = goal.Integer("approach_bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
@@ -140,7 +141,8 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     a.min_clearance = spec.NumberOr("min_clearance", a.min_clearance, 0.0, 1.0, "m");
     a.position_tolerance = spec.NumberOr("position_tolerance", a.position_tolerance, 1e-5, 1.0, "m");
     a.orientation_tolerance =
-        spec.NumberOr("orientation_tolerance_deg", a.orientation_tolerance * 180.0 / M_PI, 1e-3, 180.0, "deg") * M_PI / 180.0;
+        spec.NumberOr("orientation_tolerance_deg", a.orientation_tolerance * 180.0 / M_PI, 1e-3, 180.0, "deg") * M_PI /
+        180.0;
     if (spec.Has("renders")) a.renders = spec.Integer("renders", 0, 1000);
     spec.RejectUnknownKeys();
     s.arm_reach = a;
@@ -159,7 +161,8 @@ void ReadMission(const YamlMap& root, Scenario& s) {
   if (root.Has("initial_pose_sigma")) {
     const YamlMap sigma = root.Map("initial_pose_sigma");
     s.initial_position_sigma = sigma.NumberOr("position", s.initial_position_sigma, 0.0, 10.0, "m");
-    s.initial_yaw_sigma = sigma.NumberOr("yaw_deg", s.initial_yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
+    s.initial_yaw_sigma =
+        sigma.NumberOr("yaw_deg", s.initial_yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
     sigma.RejectUnknownKeys();
   }
   if (root.Has("calibration_error")) s.calibration_error = ReadCalibrationError(root.Map("calibration_error"));
@@ -209,9 +212,9 @@ void ReadCriteria(const YamlMap& criteria, Scenario& s) {
 
 bool IsKnownMetric(const std::string& name) {
   static const std::set<std::string> kMetrics = [] {
-    std::set<std::string> names = {"success_rate", "goal_success_rate", "trials_completed", "collisions",
-                                   "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate",
-                                   "min_clearance_m"};
+    std::set<std::string> names = {"success_rate",       "goal_success_rate", "trials_completed",
+                                   "collisions",         "recoveries",        "mean_trial_seconds",
+                                   "mean_path_length_m", "localization_rate", "min_clearance_m"};
     names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
     names.insert({"arm_goals", "arm_success_rate", "arm_contacts", "arm_tracking_error_max_rad", "arm_min_clearance_m",
                   "arm_position_error_mean_m", "arm_position_error_max_m", "arm_orientation_error_mean_deg",

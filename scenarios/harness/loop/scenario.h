@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "loop/simulated_pose_fixes.h"
 #include "loop/map_recipe.h"
+#include "loop/simulated_pose_fixes.h"
 #include "loop/world_setup.h"
 #include "trimbot/common/overrides.h"
 #include "trimbot/common/yaml_reader.h"
@@ -22,15 +22,15 @@
 namespace trimbot::scenarios {
 
 struct PassCriterion {
-  std::string metric;       // a batch metric (see ComputeBatchMetrics)
-  std::string comparison;   // ">=" (min) or "<=" (max)
+  std::string metric;      // a batch metric (see ComputeBatchMetrics)
+  std::string comparison;  // ">=" (min) or "<=" (max)
   double threshold = 0.0;
 };
 
 // How the robot's prior map differs from the garden as it stands in the simulation.
 struct Survey {
-  double growth = 0.0;                    // foliage as it was when surveyed (0..1, as Conditions)
-  std::vector<int> unmapped;              // object ids the survey missed
+  double growth = 0.0;        // foliage as it was when surveyed (0..1, as Conditions)
+  std::vector<int> unmapped;  // object ids the survey missed
   // Objects in the world that are not in the garden file either (a wheelbarrow left on the lawn):
   // placed in the simulated world, never in the map. Ids must not be the garden's.
   std::vector<garden::GardenObject> unmapped_objects;
@@ -51,7 +51,7 @@ struct CalibrationError {
 // trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff).
 struct ScenarioGoal {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's (a bush's: see MissionGoals)
-  int bush = 0;                                          // the garden object's id; 0: a point goal
+  int bush = 0;                                        // the garden object's id; 0: a point goal
 };
 
 // An arm_reach scenario (`arm_reach:`): the base stands at the start; the arm reaches `poses`
@@ -61,45 +61,45 @@ struct ScenarioGoal {
 // the bush's collision surface and its axis within max_tilt of pointing at the bush's centre.
 // Judged on the true cutter pose in base_link against the goal.
 struct ArmReach {
-  int bush = 0;                       // garden object id (a topiary or rose)
+  int bush = 0;  // garden object id (a topiary or rose)
   int poses = 10;
-  double distance_min = 0.08;         // m
-  double distance_max = 0.20;         // m
+  double distance_min = 0.08;             // m
+  double distance_max = 0.20;             // m
   double max_tilt = 60.0 * M_PI / 180.0;  // rad
-  double min_clearance = 0.08;        // m, of the witness configuration (the stack keeps ~4 cm off what it sees)
-  double position_tolerance = 0.01;   // m
+  double min_clearance = 0.08;            // m, of the witness configuration (the stack keeps ~4 cm off what it sees)
+  double position_tolerance = 0.01;       // m
   double orientation_tolerance = 2.0 * M_PI / 180.0;  // rad
-  int renders = 3;                    // PNGs of the first poses reached
+  int renders = 3;                                    // PNGs of the first poses reached
 };
 
 struct Scenario {
-  std::string source;       // file it was read from
+  std::string source;  // file it was read from
   std::string name;
   std::string description;
-  WorldSetup world;                    // world.seed is the batch seed; trial i runs with seed + i
-  double map_resolution = 0.05;        // m: the robot's prior map, made from the surveyed garden
-  double map_clearance_height = 1.0;   // m: objects whose lowest point is higher are not obstacles
+  WorldSetup world;                   // world.seed is the batch seed; trial i runs with seed + i
+  double map_resolution = 0.05;       // m: the robot's prior map, made from the surveyed garden
+  double map_clearance_height = 1.0;  // m: objects whose lowest point is higher are not obstacles
   Survey survey;
-  std::vector<ScenarioGoal> goals;     // in order (none in an arm_reach scenario)
+  std::vector<ScenarioGoal> goals;  // in order (none in an arm_reach scenario)
   std::optional<ArmReach> arm_reach;
-  double goal_tolerance = 0.3;         // m: a goal counts as reached within this (ground truth)
+  double goal_tolerance = 0.3;  // m: a goal counts as reached within this (ground truth)
   // A bush goal counts as reached when the arm's axis stands within these of the standoff
   // distance and bearing the stack aimed at (ground truth).
   double bush_distance_tolerance = 0.03;               // m
   double bush_bearing_tolerance = 3.0 * M_PI / 180.0;  // rad
-  double initial_position_sigma = 0.1; // m per axis: the stack's start belief = truth + this noise
-  double initial_yaw_sigma = 3.0 * M_PI / 180.0;  // rad
+  double initial_position_sigma = 0.1;                 // m per axis: the stack's start belief = truth + this noise
+  double initial_yaw_sigma = 3.0 * M_PI / 180.0;       // rad
   CalibrationError calibration_error;
-  std::string visual_map;              // map file for localization: visual (relative to this file)
+  std::string visual_map;  // map file for localization: visual (relative to this file)
   // Or the mapping drive the map is built from on first use (then cached; the batch sets
   // visual_map to the cached file before any trial runs).
   std::optional<MapRecipe> visual_map_recipe;
   int trials = 1;
-  double time_limit = 300.0;           // s of simulated time per trial
-  double wall_time_limit = 1800.0;     // s of wall-clock time per trial before it is killed
-  bool render_cameras = false;         // the whole ring on the camera schedule (~0.5-0.9 s a frame);
-                                       // the stack's own requests are rendered regardless
-  double resolution_scale = 0.5;       // of the scheduled ring (a request carries its own)
+  double time_limit = 300.0;        // s of simulated time per trial
+  double wall_time_limit = 1800.0;  // s of wall-clock time per trial before it is killed
+  bool render_cameras = false;      // the whole ring on the camera schedule (~0.5-0.9 s a frame);
+                                    // the stack's own requests are rendered regardless
+  double resolution_scale = 0.5;    // of the scheduled ring (a request carries its own)
   double imu_noise_scale = 1.0;
   double wheel_slip_scale = 1.0;
   SimulatedPoseFixParameters simulated_pose_fixes;  // test fixture, used when the stack asks for it

@@ -12,7 +12,8 @@ void SimulatedPoseFixes::Capture(double stamp, double x, double y, double yaw) {
   // Every draw happens for every frame, so one parameter change does not reshuffle the others.
   const double u_available = UniformUnit(rng_);
   const double u_outlier = UniformUnit(rng_);
-  const double n_x = StandardNormal(rng_), n_y = StandardNormal(rng_), n_yaw = StandardNormal(rng_), n_latency = StandardNormal(rng_);
+  const double n_x = StandardNormal(rng_), n_y = StandardNormal(rng_), n_yaw = StandardNormal(rng_),
+               n_latency = StandardNormal(rng_);
   const double outlier_distance =
       parameters_.outlier_min + (parameters_.outlier_max - parameters_.outlier_min) * UniformUnit(rng_);
   const double outlier_direction = 2.0 * M_PI * UniformUnit(rng_);

@@ -19,13 +19,13 @@
 namespace trimbot::scenarios {
 
 struct SimulatedPoseFixParameters {
-  double availability = 0.85;         // fraction of frames that localize
-  double position_sigma = 0.055;      // m per axis (mean 2D error ~6.9 cm, as in the real trials)
-  double yaw_sigma = 0.02;            // rad
-  double latency_median = 0.15;       // s, log-normal processing time ...
-  double latency_log_sigma = 0.35;    // ... with this spread of log(latency)
-  double latency_max = 1.5;           // s
-  double outlier_probability = 0.02;  // gross errors (wrong place recognized)
+  double availability = 0.85;                   // fraction of frames that localize
+  double position_sigma = 0.055;                // m per axis (mean 2D error ~6.9 cm, as in the real trials)
+  double yaw_sigma = 0.02;                      // rad
+  double latency_median = 0.15;                 // s, log-normal processing time ...
+  double latency_log_sigma = 0.35;              // ... with this spread of log(latency)
+  double latency_max = 1.5;                     // s
+  double outlier_probability = 0.02;            // gross errors (wrong place recognized)
   double outlier_min = 0.5, outlier_max = 3.0;  // m
 };
 
@@ -49,7 +49,7 @@ class SimulatedPoseFixes {
   SimulatedPoseFixParameters parameters_;
   Rng rng_;
   std::deque<Pending> pending_;
-  double busy_until_ = -1.0;   // the pipeline processes one frame at a time
+  double busy_until_ = -1.0;  // the pipeline processes one frame at a time
 };
 
 }  // namespace trimbot::scenarios

@@ -21,8 +21,9 @@ std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const garden::Garden
   std::vector<GoalTruth> truths;
   for (const ScenarioGoal& goal : scenario.goals) {
     const Eigen::Vector2d position =
-        goal.bush == 0 ? goal.position
-                       : BushOf(built, goal.bush, scenario, "goals: approach_bush " + std::to_string(goal.bush)).position;
+        goal.bush == 0
+            ? goal.position
+            : BushOf(built, goal.bush, scenario, "goals: approach_bush " + std::to_string(goal.bush)).position;
     truths.push_back({position, goal.bush});
   }
   return truths;
@@ -39,7 +40,8 @@ TrialWorld PrepareTrialWorld(const Scenario& scenario, const ProjectPaths& paths
   world.prior_map = PriorMap(scenario, world.surveyed);
   world.mission = MissionGoals(scenario, world.surveyed);
   if (scenario.arm_reach) {
-    BushOf(world.garden, scenario.arm_reach->bush, scenario, "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
+    BushOf(world.garden, scenario.arm_reach->bush, scenario,
+           "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
   }
   world.goal_truths = GoalTruths(scenario, world.garden);
   world.true_map = TrueMap(scenario, world.garden);

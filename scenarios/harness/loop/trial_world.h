@@ -19,14 +19,14 @@ namespace trimbot::scenarios {
 // A goal as the evaluation judges it.
 struct GoalTruth {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's, or the bush's true centre
-  int bush = 0;                                          // garden object id; 0: a point goal
+  int bush = 0;                                        // garden object id; 0: a point goal
 };
 
 struct TrialWorld {
   garden::Garden garden;                    // the garden file as built (the simulator adds the unmapped objects)
   garden::Garden surveyed;                  // the garden as the survey recorded it (prior_knowledge.h)
   garden::OccupancyMap prior_map;           // the robot's prior map: the surveyed garden's obstacles
-  garden::OccupancyMap true_map;           // the garden as it is in the trials, on the prior map's cells
+  garden::OccupancyMap true_map;            // the garden as it is in the trials, on the prior map's cells
   std::vector<stack::Goal> mission;         // the goals as the stack gets them (bushes as surveyed)
   std::vector<GoalTruth> goal_truths;       // where the goals truly are
   stack::StackParameters stack_parameters;  // robot/config/stack.yaml with the scenario's `stack:`

@@ -30,7 +30,7 @@ struct WorldSetup {
   sim::Pose2D start;              // true start pose of base_link (map frame)
   garden::Conditions conditions;  // time of day, season, growth
   std::uint64_t seed = 0;
-  std::string source;             // the file it was read from, for errors
+  std::string source;  // the file it was read from, for errors
 
   // Reads `garden`, `start`, `conditions` (and `seed` when `with_seed`) from a scenario or plan.
   static WorldSetup Read(const YamlMap& root, bool with_seed);

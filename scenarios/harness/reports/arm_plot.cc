@@ -30,12 +30,16 @@ void WriteArmReachPlot(const std::string& path, const std::string& title, const 
   if (n == 0.0) return;
   cv::Mat image(760, 1200, CV_8UC3, kWhite);
   PutText(image, title, {16, 30}, 0.6, kInk, 2);
-  Legend(image, 58, {{"reached", kReachedColour}, {"not reached", kFailedColour}, {"min clearance (cm)", kClearance},
-                     {"tracking error (mrad)", kTracking}});
+  Legend(image, 58,
+         {{"reached", kReachedColour},
+          {"not reached", kFailedColour},
+          {"min clearance (cm)", kClearance},
+          {"tracking error (mrad)", kTracking}});
   // Poses in base_link: x forward, y left (from above) and z up (from the side).
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   for (const auto* points : {&top_reached, &top_failed}) Extent(*points, &x0, &x1, &y0, &y1);
-  Panel top(image, {80, 100, 480, 280}, x0 - 0.05, x1 + 0.05, y0, y1, "cutter goals from above: y (m) over x (m), base_link");
+  Panel top(image, {80, 100, 480, 280}, x0 - 0.05, x1 + 0.05, y0, y1,
+            "cutter goals from above: y (m) over x (m), base_link");
   top.Dots(top_reached, kReachedColour, 4);
   top.Dots(top_failed, kFailedColour, 4);
   y0 = std::numeric_limits<double>::infinity(), y1 = -y0;
@@ -51,7 +55,8 @@ void WriteArmReachPlot(const std::string& path, const std::string& title, const 
   double c1 = 1.0;
   Extent(clearance_cm, &unused0, &unused1, &e0, &c1);
   Extent(tracking_mrad, &unused0, &unused1, &e0, &c1);
-  Panel motion(image, {660, 450, 480, 260}, -0.5, n - 0.5, 0.0, c1, "per goal: min clearance (cm), tracking error (mrad)");
+  Panel motion(image, {660, 450, 480, 260}, -0.5, n - 0.5, 0.0, c1,
+               "per goal: min clearance (cm), tracking error (mrad)");
   motion.Dots(clearance_cm, kClearance, 3);
   motion.Dots(tracking_mrad, kTracking, 3);
   PutText(image, "goal (all trials, in order)", {80, 735}, 0.4, kInk);

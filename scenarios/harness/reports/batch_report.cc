@@ -27,15 +27,31 @@ std::string XmlEscape(const std::string& text) {
   out.reserve(text.size());
   for (const char ch : text) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
       // Line breaks survive in attributes only as character references.
-      case '\n': out += "&#10;"; break;
-      case '\r': out += "&#13;"; break;
-      case '\t': out += "&#9;"; break;
+      case '\n':
+        out += "&#10;";
+        break;
+      case '\r':
+        out += "&#13;";
+        break;
+      case '\t':
+        out += "&#9;";
+        break;
       default:
         // Other control characters are not allowed anywhere in XML 1.0.
         out += static_cast<unsigned char>(ch) < 0x20 ? '?' : ch;
@@ -140,12 +156,12 @@ cv::Mat RenderMap(const garden::OccupancyMap& map, const garden::OccupancyMap& w
   const Eigen::Vector2d low = map.origin, high = map.origin + MapSize(map);
   const cv::Point2d shift(-to_image.offset.x, -to_image.offset.y);  // this image starts at the map corner
   for (double x = std::ceil(low.x()); x <= high.x(); x += 1.0) {
-    cv::line(image, FixedPoint(to_image({x, low.y()}) + shift), FixedPoint(to_image({x, high.y()}) + shift), kGridLine, 1,
-             cv::LINE_8, kSubpixelBits);
+    cv::line(image, FixedPoint(to_image({x, low.y()}) + shift), FixedPoint(to_image({x, high.y()}) + shift), kGridLine,
+             1, cv::LINE_8, kSubpixelBits);
   }
   for (double y = std::ceil(low.y()); y <= high.y(); y += 1.0) {
-    cv::line(image, FixedPoint(to_image({low.x(), y}) + shift), FixedPoint(to_image({high.x(), y}) + shift), kGridLine, 1,
-             cv::LINE_8, kSubpixelBits);
+    cv::line(image, FixedPoint(to_image({low.x(), y}) + shift), FixedPoint(to_image({high.x(), y}) + shift), kGridLine,
+             1, cv::LINE_8, kSubpixelBits);
   }
   image.setTo(kNotInMap, in_world & ~occupied);
   image.setTo(kOccupied, occupied);
@@ -212,7 +228,8 @@ constexpr double kBinCm = 2.0, kMinRangeCm = 50.0;
 // `phase` shifts the dashes, so that two lines at the same place stay visible in turn.
 void DrawDashedVertical(cv::Mat& image, int x, int top, int bottom, const cv::Scalar& colour, int thickness,
                         int phase) {
-  for (int y = top + phase; y < bottom; y += 10) cv::line(image, {x, y}, {x, std::min(y + 4, bottom)}, colour, thickness);
+  for (int y = top + phase; y < bottom; y += 10)
+    cv::line(image, {x, y}, {x, std::min(y + 4, bottom)}, colour, thickness);
 }
 
 struct Histogram {
@@ -383,8 +400,8 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary) {
 }
 
 void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
-                         const std::vector<PlotTrajectory>& trajectories,
-                         const std::vector<Eigen::Vector2d>& goals, const std::string& title) {
+                         const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
+                         const std::string& title) {
   const Eigen::Vector2d map_size = MapSize(map);
   if (map.occupied.empty() || map_size.x() <= 0 || map_size.y() <= 0) {
     throw std::invalid_argument(path + ": cannot plot trajectories over an empty map");
@@ -453,7 +470,8 @@ void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult
   cv::Mat image(kTitleHeight + rows * kPanelHeight, columns * kPanelWidth, CV_8UC3, kWhite);
   PutText(image, title, {16, 34}, 0.8, kInk, 2);
   if (names.empty()) {
-    PutTextCentred(image, "no localization error samples", {image.cols / 2, kTitleHeight + kPanelHeight / 2}, 0.7, kInk);
+    PutTextCentred(image, "no localization error samples", {image.cols / 2, kTitleHeight + kPanelHeight / 2}, 0.7,
+                   kInk);
   }
   for (std::size_t i = 0; i < names.size(); ++i) {
     const cv::Rect panel(static_cast<int>(i % columns) * kPanelWidth,
@@ -483,8 +501,8 @@ std::vector<Eigen::Vector2d> ReadTumPositions(const std::string& path) {
       values.push_back(value);
     }
     if (values.size() != 8) {
-      throw InputError(path, "line " + std::to_string(line_number) + ": expected 8 numbers \"t x y z qx qy qz qw\", got " +
-                                 std::to_string(values.size()));
+      throw InputError(path, "line " + std::to_string(line_number) +
+                                 ": expected 8 numbers \"t x y z qx qy qz qw\", got " + std::to_string(values.size()));
     }
     positions.emplace_back(values[1], values[2]);
   }

@@ -22,11 +22,10 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary);
 // `map`: the robot's prior map; `world`: the garden as it really is on the same cells (what the
 // map lacks is drawn in its own colour).
 void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
-                         const std::vector<PlotTrajectory>& trajectories,
-                         const std::vector<Eigen::Vector2d>& goals, const std::string& title);
+                         const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
+                         const std::string& title);
 // One panel per estimate name found in the trials (position error in centimetres).
-void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult>& trials,
-                          const std::string& title);
+void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult>& trials, const std::string& title);
 // x, y of each line of a TUM trajectory file ("t x y z qx qy qz qw"; # comments skipped).
 // Throws InputError naming the file and line when it is malformed.
 std::vector<Eigen::Vector2d> ReadTumPositions(const std::string& path);

@@ -10,7 +10,7 @@
 namespace trimbot::scenarios {
 namespace {
 
-constexpr double kReferenceDistanceCm = 1.26;   // D3.4 Figure 20: mean over 5 trials
+constexpr double kReferenceDistanceCm = 1.26;  // D3.4 Figure 20: mean over 5 trials
 constexpr double kReferenceBearingDeg = 2.08;
 
 const cv::Scalar kAxis(60, 60, 60), kTruth(120, 120, 120), kEstimate(40, 110, 200), kReached(220, 120, 40),
@@ -19,7 +19,8 @@ const cv::Scalar kAxis(60, 60, 60), kTruth(120, 120, 120), kEstimate(40, 110, 20
 }  // namespace
 
 void WriteBushFramePlot(const std::string& path, const std::string& title, const std::vector<TrialResult>& trials) {
-  const auto trial = std::find_if(trials.begin(), trials.end(), [](const TrialResult& t) { return !t.bush_frames.empty(); });
+  const auto trial =
+      std::find_if(trials.begin(), trials.end(), [](const TrialResult& t) { return !t.bush_frames.empty(); });
   if (trial == trials.end()) return;
   std::vector<int> goals;
   for (const BushFrame& f : trial->bush_frames) {
@@ -44,13 +45,15 @@ void WriteBushFramePlot(const std::string& path, const std::string& title, const
     double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
     Extent(true_distance, &x0, &x1, &y0, &y1);
     Extent(estimated_distance, &x0, &x1, &y0, &y1);
-    Panel distance(image, {80, top, 420, row_height - 40}, x0, x1, y0, y1, goal + ": distance to the bush's centre (m) over time");
+    Panel distance(image, {80, top, 420, row_height - 40}, x0, x1, y0, y1,
+                   goal + ": distance to the bush's centre (m) over time");
     distance.Line(true_distance, kTruth, 2);
     distance.Dots(estimated_distance, kEstimate);
     y0 = std::numeric_limits<double>::infinity(), y1 = -y0;
     Extent(true_bearing, &x0, &x1, &y0, &y1);
     Extent(estimated_bearing, &x0, &x1, &y0, &y1);
-    Panel bearing(image, {620, top, 420, row_height - 40}, x0, x1, y0, y1, goal + ": bearing of the bush (deg) over time");
+    Panel bearing(image, {620, top, 420, row_height - 40}, x0, x1, y0, y1,
+                  goal + ": bearing of the bush (deg) over time");
     bearing.Line(true_bearing, kTruth, 2);
     bearing.Dots(estimated_bearing, kEstimate);
   }
@@ -91,8 +94,11 @@ void WriteBushErrorPlot(const std::string& path, const std::string& title, const
   const int width = std::max(900, 120 + 30 * static_cast<int>(columns.size()));
   cv::Mat image(640, width, CV_8UC3, kWhite);
   PutText(image, title, {16, 30}, 0.6, kInk, 2);
-  Legend(image, 58, {{"per frame at 1-3 m (mean)", kTruth}, {"estimate at arrival", kEstimate},
-                     {"pose reached vs target", kReached}, {"real robot (D3.4 Fig. 20)", kReference}});
+  Legend(image, 58,
+         {{"per frame at 1-3 m (mean)", kTruth},
+          {"estimate at arrival", kEstimate},
+          {"pose reached vs target", kReached},
+          {"real robot (D3.4 Fig. 20)", kReference}});
   const double n = static_cast<double>(columns.size());
   const auto draw = [&](int top, const std::string& label, double reference, auto frame, auto estimate, auto reached) {
     double high = reference;
@@ -107,13 +113,16 @@ void WriteBushErrorPlot(const std::string& path, const std::string& title, const
       bar(0.12, frame(columns[i]), kTruth);
       bar(0.37, estimate(columns[i]), kEstimate);
       bar(0.62, reached(columns[i]), kReached);
-      if (columns.size() <= 64) PutTextCentred(image, columns[i].label, panel.At(x + 0.5, 0.0) + cv::Point(0, 14), 0.3, kAxis);
+      if (columns.size() <= 64)
+        PutTextCentred(image, columns[i].label, panel.At(x + 0.5, 0.0) + cv::Point(0, 14), 0.3, kAxis);
     }
   };
-  draw(100, "distance error (cm), by bush id", kReferenceDistanceCm, [](const Column& c) { return c.frame_distance_cm; },
-       [](const Column& c) { return c.estimate_distance_cm; }, [](const Column& c) { return c.reached_distance_cm; });
-  draw(380, "bearing error (deg), by bush id", kReferenceBearingDeg, [](const Column& c) { return c.frame_bearing_deg; },
-       [](const Column& c) { return c.estimate_bearing_deg; }, [](const Column& c) { return c.reached_bearing_deg; });
+  draw(
+      100, "distance error (cm), by bush id", kReferenceDistanceCm, [](const Column& c) { return c.frame_distance_cm; },
+      [](const Column& c) { return c.estimate_distance_cm; }, [](const Column& c) { return c.reached_distance_cm; });
+  draw(
+      380, "bearing error (deg), by bush id", kReferenceBearingDeg, [](const Column& c) { return c.frame_bearing_deg; },
+      [](const Column& c) { return c.estimate_bearing_deg; }, [](const Column& c) { return c.reached_bearing_deg; });
   WritePng(path, image);
 }
 

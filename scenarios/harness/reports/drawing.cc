@@ -20,12 +20,24 @@ cv::Scalar HsvToRgb(double hue_deg, double saturation, double value) {
   const double x = chroma * (1.0 - std::abs(std::fmod(h, 2.0) - 1.0));
   double r = 0, g = 0, b = 0;
   switch (static_cast<int>(h)) {
-    case 0: r = chroma, g = x; break;
-    case 1: r = x, g = chroma; break;
-    case 2: g = chroma, b = x; break;
-    case 3: g = x, b = chroma; break;
-    case 4: r = x, b = chroma; break;
-    default: r = chroma, b = x; break;
+    case 0:
+      r = chroma, g = x;
+      break;
+    case 1:
+      r = x, g = chroma;
+      break;
+    case 2:
+      g = chroma, b = x;
+      break;
+    case 3:
+      g = x, b = chroma;
+      break;
+    case 4:
+      r = x, b = chroma;
+      break;
+    default:
+      r = chroma, b = x;
+      break;
   }
   const double m = value - chroma;
   return cv::Scalar((r + m) * 255.0, (g + m) * 255.0, (b + m) * 255.0);
@@ -97,7 +109,8 @@ cv::Point Panel::At(double x, double y) const {
 
 void Panel::Line(const std::vector<cv::Point2d>& points, const cv::Scalar& colour, int thickness) {
   for (std::size_t i = 1; i < points.size(); ++i) {
-    cv::line(image_, At(points[i - 1].x, points[i - 1].y), At(points[i].x, points[i].y), colour, thickness, cv::LINE_AA);
+    cv::line(image_, At(points[i - 1].x, points[i - 1].y), At(points[i].x, points[i].y), colour, thickness,
+             cv::LINE_AA);
   }
 }
 
@@ -105,7 +118,9 @@ void Panel::Dots(const std::vector<cv::Point2d>& points, const cv::Scalar& colou
   for (const auto& p : points) cv::circle(image_, At(p.x, p.y), radius, colour, cv::FILLED, cv::LINE_AA);
 }
 
-void Panel::Horizontal(double y, const cv::Scalar& colour) { cv::line(image_, At(x0_, y), At(x1_, y), colour, 1, cv::LINE_AA); }
+void Panel::Horizontal(double y, const cv::Scalar& colour) {
+  cv::line(image_, At(x0_, y), At(x1_, y), colour, 1, cv::LINE_AA);
+}
 
 void Extent(const std::vector<cv::Point2d>& points, double* x0, double* x1, double* y0, double* y1) {
   for (const auto& p : points) {

@@ -16,7 +16,9 @@ using visual_localization::LocalizationTimings;
 
 constexpr std::array<const char*, 4> kStages = {"features", "retrieval", "matching", "pose"};
 
-std::array<double, 4> StageSeconds(const LocalizationTimings& t) { return {t.features, t.retrieval, t.matching, t.pose}; }
+std::array<double, 4> StageSeconds(const LocalizationTimings& t) {
+  return {t.features, t.retrieval, t.matching, t.pose};
+}
 double TotalSeconds(const LocalizationTimings& t) { return t.features + t.retrieval + t.matching + t.pose; }
 
 nlohmann::json Stats(const std::vector<double>& ms) {
@@ -78,7 +80,9 @@ void WriteLocalizationTimeHistogram(const std::string& path, const std::string& 
   const int most = std::max(1, *std::max_element(count.begin(), count.end()));
   const double count_step = NiceStep(most, 5);
   const double count_top = std::ceil(most / count_step) * count_step;
-  const auto y_of = [&](double c) { return plot.y + plot.height - static_cast<int>(std::lround(c / count_top * plot.height)); };
+  const auto y_of = [&](double c) {
+    return plot.y + plot.height - static_cast<int>(std::lround(c / count_top * plot.height));
+  };
   const auto x_of = [&](double ms) { return plot.x + static_cast<int>(std::lround(ms / (bins * bin) * plot.width)); };
   for (double c = 0; c <= count_top + 1e-9; c += count_step) {
     cv::line(image, {plot.x, y_of(c)}, {plot.x + plot.width, y_of(c)}, grid, 1);
@@ -94,8 +98,8 @@ void WriteLocalizationTimeHistogram(const std::string& path, const std::string& 
     double below = 0.0;  // frames stacked so far, split by the stages' shares of this bin's time
     for (std::size_t s = 0; s < 4; ++s) {
       const double part = sum > 0 ? count[i] * stage_sum[i][s] / sum : 0.0;
-      cv::rectangle(image, cv::Point(x_of(b * bin) + 1, y_of(below + part)), cv::Point(x_of((b + 1) * bin) - 1, y_of(below)),
-                    colours[s], cv::FILLED);
+      cv::rectangle(image, cv::Point(x_of(b * bin) + 1, y_of(below + part)),
+                    cv::Point(x_of((b + 1) * bin) - 1, y_of(below)), colours[s], cv::FILLED);
       below += part;
     }
   }
@@ -104,19 +108,24 @@ void WriteLocalizationTimeHistogram(const std::string& path, const std::string& 
   for (double ms = 0; ms <= bins * bin + 1e-9; ms += tick) {
     PutTextCentred(image, FormatNumber(ms), {x_of(ms), plot.y + plot.height + 18}, 0.42, axis);
   }
-  PutTextCentred(image, "processing time per ring frame (ms)", {plot.x + plot.width / 2, plot.y + plot.height + 44}, 0.5, kInk);
+  PutTextCentred(image, "processing time per ring frame (ms)", {plot.x + plot.width / 2, plot.y + plot.height + 44},
+                 0.5, kInk);
   PutText(image, "frames", {10, plot.y - 12}, 0.45, kInk);
   const nlohmann::json stats = LocalizationTimeStats(frames);
   for (std::size_t s = 0; s < 4; ++s) {
     const int ly = plot.y + 14 + 24 * static_cast<int>(s);
     cv::rectangle(image, cv::Rect(plot.x + plot.width + 20, ly - 11, 14, 14), colours[s], cv::FILLED);
-    PutText(image, std::string(kStages[s]) + "  median " + FormatFixed(stats[kStages[s]]["median_ms"].get<double>(), 1) + " ms",
-            {plot.x + plot.width + 40, ly}, 0.42, kInk);
+    PutText(
+        image,
+        std::string(kStages[s]) + "  median " + FormatFixed(stats[kStages[s]]["median_ms"].get<double>(), 1) + " ms",
+        {plot.x + plot.width + 40, ly}, 0.42, kInk);
   }
   const int ty = plot.y + 14 + 24 * 5;
   PutText(image, "total  median " + FormatFixed(stats["total"]["median_ms"].get<double>(), 1) + " ms",
           {plot.x + plot.width + 20, ty}, 0.45, kInk, 1);
-  PutText(image, "p90 " + FormatFixed(stats["total"]["p90_ms"].get<double>(), 1) + " ms, " + std::to_string(frames.size()) + " frames",
+  PutText(image,
+          "p90 " + FormatFixed(stats["total"]["p90_ms"].get<double>(), 1) + " ms, " + std::to_string(frames.size()) +
+              " frames",
           {plot.x + plot.width + 20, ty + 22}, 0.42, axis);
   PutText(image, "bars split by each stage's share of the time in the bin", {plot.x, kHeight - 14}, 0.4, axis);
   WritePng(path, image);

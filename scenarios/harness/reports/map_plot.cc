@@ -11,7 +11,8 @@ namespace trimbot::scenarios {
 void WriteMapTopView(const std::string& path, const visual_localization::VisualMap& map,
                      const garden::OccupancyMap& objects, const std::string& title) {
   constexpr int kWidth = 1200, kTitle = 50;
-  const double width_m = objects.occupied.cols * objects.resolution, height_m = objects.occupied.rows * objects.resolution;
+  const double width_m = objects.occupied.cols * objects.resolution,
+               height_m = objects.occupied.rows * objects.resolution;
   const double scale = kWidth / width_m;  // px per metre
   const int height = kTitle + static_cast<int>(std::lround(height_m * scale)) + 30;
   cv::Mat image(height, kWidth, CV_8UC3, kWhite);
@@ -35,8 +36,9 @@ void WriteMapTopView(const std::string& path, const visual_localization::VisualM
     cv::circle(image, to_pixel(t.x(), t.y()), 4, kInk, cv::FILLED, cv::LINE_AA);
   }
   PutText(image, title, {12, 32}, 0.65, kInk, 2);
-  PutText(image, "points coloured by height (blue 0 m .. red 1.5 m), keyframes black, objects grey, 1 px = " +
-                     FormatFixed(100.0 / scale, 1) + " cm",
+  PutText(image,
+          "points coloured by height (blue 0 m .. red 1.5 m), keyframes black, objects grey, 1 px = " +
+              FormatFixed(100.0 / scale, 1) + " cm",
           {12, height - 10}, 0.42, kInk);
   WritePng(path, image);
 }

@@ -33,8 +33,8 @@ void WriteDepthPng(const std::string& path, const cv::Mat& depth_m) {
 cv::Mat ColouriseClasses(const cv::Mat& object_class) {
   // RGB colours per garden::ObjectClass value.
   static const cv::Vec3b kColours[] = {
-      {0, 0, 0},       {120, 170, 90},  {20, 110, 40}, {200, 60, 110}, {40, 150, 120},
-      {90, 200, 90},   {120, 80, 40},   {200, 160, 90}, {150, 150, 160}, {230, 220, 40},
+      {0, 0, 0},     {120, 170, 90}, {20, 110, 40},  {200, 60, 110},  {40, 150, 120},
+      {90, 200, 90}, {120, 80, 40},  {200, 160, 90}, {150, 150, 160}, {230, 220, 40},
   };
   cv::Mat out(object_class.size(), CV_8UC3);
   for (int r = 0; r < object_class.rows; ++r) {

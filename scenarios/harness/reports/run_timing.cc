@@ -9,8 +9,8 @@
 
 namespace trimbot::scenarios {
 
-RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim::SimulatorTimings& sim, const stack::StackTimings* stack, double setup_seconds,
-                        double report_seconds) {
+RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim::SimulatorTimings& sim,
+                        const stack::StackTimings* stack, double setup_seconds, double report_seconds) {
   RunTiming t;
   t.wall_seconds = wall_seconds;
   t.simulated_seconds = simulated_seconds;
@@ -30,7 +30,8 @@ RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim
       v.pose += f.pose;
     }
     const auto frames = static_cast<long>(stack->visual_frames.size());
-    const double visual_rest = std::max(0.0, stack->visual_localization - (v.features + v.retrieval + v.matching + v.pose));
+    const double visual_rest =
+        std::max(0.0, stack->visual_localization - (v.features + v.retrieval + v.matching + v.pose));
     const std::vector<StageTime> stack_stages = {
         {"ekf", "stack", stack->ekf, 0, ""},
         {"visual_features", "stack", v.features, frames, "localized frame"},
@@ -57,12 +58,9 @@ RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim
 nlohmann::json ToJson(const RunTiming& t) {
   nlohmann::json stages = nlohmann::json::array();
   for (const auto& s : t.stages) {
-    nlohmann::json row = {{"name", s.name},
-                          {"group", s.group},
-                          {"seconds", s.seconds},
-                          {"share", t.wall_seconds > 0 ? s.seconds / t.wall_seconds : 0.0},
-                          {"count", s.count},
-                          {"per", s.per}};
+    nlohmann::json row = {{"name", s.name},       {"group", s.group},
+                          {"seconds", s.seconds}, {"share", t.wall_seconds > 0 ? s.seconds / t.wall_seconds : 0.0},
+                          {"count", s.count},     {"per", s.per}};
     if (s.count > 0) row["ms_per"] = 1000.0 * s.seconds / static_cast<double>(s.count);
     stages.push_back(row);
   }
@@ -92,8 +90,8 @@ RunTiming Sum(const std::vector<RunTiming>& runs) {
     total.wall_seconds += run.wall_seconds;
     total.simulated_seconds += run.simulated_seconds;
     for (const auto& s : run.stages) {
-      auto found = std::find_if(total.stages.begin(), total.stages.end(),
-                                [&](const StageTime& t) { return t.name == s.name; });
+      auto found =
+          std::find_if(total.stages.begin(), total.stages.end(), [&](const StageTime& t) { return t.name == s.name; });
       if (found == total.stages.end()) {
         total.stages.push_back(s);
       } else {

@@ -19,8 +19,8 @@ struct StageTime {
   std::string name;   // e.g. "render_draw"
   std::string group;  // simulator | stack | runner
   double seconds = 0.0;
-  long count = 0;     // what the time is spread over (0: nothing counted) ...
-  std::string per;    // ... e.g. "camera image", "ring frame", "physics step"
+  long count = 0;   // what the time is spread over (0: nothing counted) ...
+  std::string per;  // ... e.g. "camera image", "ring frame", "physics step"
 };
 
 struct RunTiming {
@@ -31,8 +31,8 @@ struct RunTiming {
 
 // `stack` may be null (no robot software ran). `setup_seconds` and `report_seconds` are the
 // runner's own (world and stack construction; writing the outputs).
-RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim::SimulatorTimings& simulator, const stack::StackTimings* stack,
-                        double setup_seconds, double report_seconds);
+RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim::SimulatorTimings& simulator,
+                        const stack::StackTimings* stack, double setup_seconds, double report_seconds);
 
 // {"wall_seconds", "simulated_seconds", "real_time_factor", "stages": [{"name", "group",
 // "seconds", "share", "count", "per", "ms_per"}...]}.

@@ -25,7 +25,8 @@ void YRange(const std::vector<SweepSeries>& series, double* low, double* high, d
     }
   }
   if (!std::isfinite(*low)) *low = 0.0, *high = 1.0;
-  if (*high - *low < 1e-12) *low -= 0.5 * std::max(1e-3, std::abs(*low)), *high += 0.5 * std::max(1e-3, std::abs(*high));
+  if (*high - *low < 1e-12)
+    *low -= 0.5 * std::max(1e-3, std::abs(*low)), *high += 0.5 * std::max(1e-3, std::abs(*high));
   *step = NiceStep(*high - *low, 6);
   *low = std::floor(*low / *step) * *step;
   *high = std::ceil(*high / *step) * *step;
@@ -39,9 +40,13 @@ void WriteSweepPlot(const std::string& path, const std::string& title, const std
   cv::Mat image(kHeight, kWidth, CV_8UC3, kWhite);
   double y_low = 0, y_high = 1, y_step = 1;
   YRange(series, &y_low, &y_high, &y_step);
-  const auto y_of = [&](double v) { return kPlot.y + kPlot.height - static_cast<int>(std::lround((v - y_low) / (y_high - y_low) * kPlot.height)); };
+  const auto y_of = [&](double v) {
+    return kPlot.y + kPlot.height - static_cast<int>(std::lround((v - y_low) / (y_high - y_low) * kPlot.height));
+  };
   const int n = static_cast<int>(x_values.size());
-  const auto x_of = [&](int i) { return kPlot.x + static_cast<int>(std::lround((i + 0.5) * kPlot.width / std::max(1, n))); };
+  const auto x_of = [&](int i) {
+    return kPlot.x + static_cast<int>(std::lround((i + 0.5) * kPlot.width / std::max(1, n)));
+  };
   const cv::Scalar grid(225, 225, 225), axis(60, 60, 60);
   PutText(image, title, {16, 32}, 0.65, kInk, 2);
   for (double v = y_low; v <= y_high + 1e-9 * y_step; v += y_step) {

@@ -7,8 +7,8 @@
 namespace trimbot::scenarios {
 
 struct SweepSeries {
-  std::string label;           // the other parameters' values, e.g. "planner.iterations=3000"
-  std::vector<double> value;   // per x position (NaN: no value)
+  std::string label;          // the other parameters' values, e.g. "planner.iterations=3000"
+  std::vector<double> value;  // per x position (NaN: no value)
   std::vector<double> low, high;
 };
 

@@ -4,31 +4,31 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
-#include <cstdio>
-#include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
 #include "evaluation/trial_evaluator.h"
+#include "loop/prior_knowledge.h"
+#include "loop/scenario.h"
 #include "reports/arm_plot.h"
-#include "reports/bush_plot.h"
 #include "reports/batch_report.h"
+#include "reports/bush_plot.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
 #include "runners/map_cache.h"
-#include "loop/prior_knowledge.h"
-#include "loop/scenario.h"
 #include "runners/trial.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
@@ -42,15 +42,18 @@ using nlohmann::json;
 
 // What a run was asked to do; written as batch.json, read back by merge.
 struct BatchInfo {
-  std::string scenario_file;   // the copy in the output folder is scenario.yaml
+  std::string scenario_file;  // the copy in the output folder is scenario.yaml
   std::uint64_t seed = 0;
   int trials = 0;
   int shard_index = 0, shard_count = 1;
-  std::vector<std::string> overrides;   // --set, as given
+  std::vector<std::string> overrides;  // --set, as given
 };
 
 json ToJson(const BatchInfo& info) {
-  return {{"scenario_file", info.scenario_file}, {"seed", info.seed}, {"trials", info.trials}, {"overrides", info.overrides},
+  return {{"scenario_file", info.scenario_file},
+          {"seed", info.seed},
+          {"trials", info.trials},
+          {"overrides", info.overrides},
           {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)}};
 }
 
@@ -115,8 +118,8 @@ std::string OneLine(const TrialResult& r) {
   line << std::fixed << std::setprecision(1) << "trial " << std::setw(3) << std::setfill('0') << r.index
        << std::setfill(' ') << " seed " << r.seed << ": " << (r.success ? "success" : "FAILED") << " (" << r.status
        << (r.message.empty() ? "" : ": " + r.message) << "), " << (r.arm_goals.empty() ? "goals " : "cutter poses ")
-       << reached << "/" << r.goals.size() + r.arm_goals.size() << ", "
-       << r.simulated_seconds << " s simulated, " << r.wall_seconds << " s wall";
+       << reached << "/" << r.goals.size() + r.arm_goals.size() << ", " << r.simulated_seconds << " s simulated, "
+       << r.wall_seconds << " s wall";
   for (const auto& e : r.estimates) {
     if (e.name == "ekf" && !e.position_m.empty()) {
       line << std::setprecision(3) << ", EKF error mean " << e.position().mean << " m";
@@ -189,8 +192,10 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
 // Summary, JUnit and plots of a set of trial results, written into `out`; returns the exit code.
 // `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
 // `final_out`: the folder the log names (merge builds the reports beside it and swaps them in).
-int WriteReports(const std::string& out, const std::string& final_out, const Scenario& scenario, const garden::OccupancyMap& map,
-                 const garden::OccupancyMap& world, const std::vector<Eigen::Vector2d>& goals, const BatchInfo& info, std::vector<TrialResult> results, int trials_planned, std::ostream& log) {
+int WriteReports(const std::string& out, const std::string& final_out, const Scenario& scenario,
+                 const garden::OccupancyMap& map, const garden::OccupancyMap& world,
+                 const std::vector<Eigen::Vector2d>& goals, const BatchInfo& info, std::vector<TrialResult> results,
+                 int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   BatchSummary summary;
   summary.scenario = scenario.name;
@@ -223,21 +228,25 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
     for (const auto& r : results) {
       const std::string dir = TrialDir(out, r.index);
       if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
-      trajectories.push_back({r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
+      trajectories.push_back(
+          {r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
     }
-    WriteTrajectoryPlot(out + "/trajectories.png", map, world, trajectories, goals,
-                        scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
-    WriteErrorHistograms(out + "/localization_errors.png", results, scenario.name + ": localization error against ground truth");
+    WriteTrajectoryPlot(
+        out + "/trajectories.png", map, world, trajectories, goals,
+        scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
+    WriteErrorHistograms(out + "/localization_errors.png", results,
+                         scenario.name + ": localization error against ground truth");
     WriteBushFramePlot(out + "/bush_frames.png", scenario.name + ": the bush from stereo per frame", results);
-    WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth", results);
+    WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth",
+                       results);
   }
 
   log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
   for (const auto& r : results) log << "  " << OneLine(r) << "\n";
   log << "criteria:\n";
   for (const auto& c : summary.criteria) {
-    log << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
-              << " (actual " << c.actual << ")\n";
+    log << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected << " (actual "
+        << c.actual << ")\n";
   }
   if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
   if (!timing.arm_planning.is_null()) {
@@ -247,8 +256,9 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
         << plans["plans"].get<int>() << " plans\n";
   }
   log << "outputs in " << final_out << " (summary.json, junit.xml, timing.json, timing.png, "
-      << (scenario.arm_reach ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
-                             : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");
+      << (scenario.arm_reach
+              ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
+              : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");
   return summary.pass ? 0 : 1;
 }
 
@@ -264,9 +274,7 @@ struct RunningTrial {
 [[noreturn]] void RunTrialProcess(const TrialSetup& setup) {
   int code = 0;
   try {
-    RunTrial(setup, [&](double t) {
-      std::ofstream(setup.dir + "/progress") << t << "\n";
-    });
+    RunTrial(setup, [&](double t) { std::ofstream(setup.dir + "/progress") << t << "\n"; });
   } catch (const std::exception& e) {
     TrialResult result = Unfinished(setup.index, setup.seed, "error", e.what());
     try {
@@ -316,7 +324,8 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
   trial.dir = TrialDir(options.out_dir, index);
   fs::remove_all(trial.dir);
   fs::create_directories(trial.dir);
-  const TrialSetup setup{&scenario, &world, options.paths, options.out_dir + "/map/map.yaml", trial.dir, index, trial.seed};
+  const TrialSetup setup{&scenario, &world, options.paths, options.out_dir + "/map/map.yaml",
+                         trial.dir, index,  trial.seed};
   std::cout.flush();
   trial.started = Clock::now();
   trial.pid = fork();
@@ -341,8 +350,9 @@ std::optional<TrialResult> PollTrial(const RunningTrial& trial, const Scenario& 
   } else if (done == trial.pid) {
     result = ReadTrialResult(trial.dir);
     if (WIFSIGNALED(status)) {
-      result = Unfinished(trial.index, trial.seed, "crashed", "killed by signal " + std::to_string(WTERMSIG(status)) +
-                                                                  " (" + strsignal(WTERMSIG(status)) + ")");
+      result =
+          Unfinished(trial.index, trial.seed, "crashed",
+                     "killed by signal " + std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")");
     } else if (!result) {
       result = Unfinished(trial.index, trial.seed, "crashed",
                           "exited with code " + std::to_string(WEXITSTATUS(status)) + " without a result");
@@ -419,8 +429,7 @@ int RunBatch(const BatchOptions& options) {
   std::ostream& log = options.quiet ? null_log : std::cout;
   const bool interactive = !options.quiet && isatty(STDOUT_FILENO) != 0;
   log << "[run] " << scenario.name << ": " << planned << " trials (shard " << info.shard_index << "/"
-            << info.shard_count << ", seeds " << info.seed << "+i), " << options.jobs << " at a time -> " << out
-            << std::endl;
+      << info.shard_count << ", seeds " << info.seed << "+i), " << options.jobs << " at a time -> " << out << std::endl;
   const auto batch_start = Clock::now();
   std::vector<RunningTrial> running;
   // If the batch stops on an exception, no trial process is left running into the output folder.
@@ -489,8 +498,9 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
       scenario_text = text;
     } else if (info.seed != shards.front().info.seed || info.trials != shards.front().info.trials ||
                info.shard_count != shards.front().info.shard_count || text != scenario_text) {
-      throw InputError(dir + "/batch.json", "belongs to another batch (scenario, seed, trials or shard count differ from " +
-                                                 shard_dirs.front() + ")");
+      throw InputError(
+          dir + "/batch.json",
+          "belongs to another batch (scenario, seed, trials or shard count differ from " + shard_dirs.front() + ")");
     }
     shards.push_back({dir, info});
   }
@@ -500,7 +510,8 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   fs::create_directories(staging + "/trials");
   WriteFileAtomically(staging + "/scenario.yaml", scenario_text);
   fs::create_directories(staging + "/map");
-  fs::copy(shards.front().dir + "/map", staging + "/map", fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+  fs::copy(shards.front().dir + "/map", staging + "/map",
+           fs::copy_options::overwrite_existing | fs::copy_options::recursive);
   std::map<int, TrialResult> results;
   for (const Shard& shard : shards) {
     for (int i = shard.info.shard_index; i < shard.info.trials; i += shard.info.shard_count) {
@@ -525,9 +536,9 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
   const Scenario scenario = Scenario::Load(staging + "/scenario.yaml");
   const TrialWorld world = PrepareTrialWorld(scenario, paths);
   std::ostream null_log(nullptr);  // writes nothing
-  const int exit_code = WriteReports(staging, out_dir, scenario, world.prior_map, world.true_map,
-                                     GoalPositions(world.mission), merged, found, merged.trials,
-                                     quiet ? null_log : std::cout);
+  const int exit_code =
+      WriteReports(staging, out_dir, scenario, world.prior_map, world.true_map, GoalPositions(world.mission), merged,
+                   found, merged.trials, quiet ? null_log : std::cout);
   ReplaceFolder(staging, out_dir);
   return exit_code;
 }

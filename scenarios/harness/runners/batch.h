@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "loop/trial_world.h"
 #include "loop/scenario.h"
+#include "loop/trial_world.h"
 #include "loop/world_setup.h"
 
 namespace trimbot::scenarios {
@@ -34,13 +34,13 @@ struct BatchOptions {
   std::string scenario_path;
   std::string out_dir;
   ProjectPaths paths;
-  std::optional<int> trials;            // overrides the scenario's
-  std::optional<std::uint64_t> seed;    // overrides the scenario's
+  std::optional<int> trials;          // overrides the scenario's
+  std::optional<std::uint64_t> seed;  // overrides the scenario's
   int jobs = DefaultJobs();
   int shard_index = 0, shard_count = 1;
-  bool keep_worlds = false;             // keep each trial's composed MuJoCo world (large textures)
-  std::vector<std::string> overrides;   // --set key.path=value, applied to the scenario file
-  bool quiet = false;                   // no per-trial lines or report listing (sweeps, tuning)
+  bool keep_worlds = false;            // keep each trial's composed MuJoCo world (large textures)
+  std::vector<std::string> overrides;  // --set key.path=value, applied to the scenario file
+  bool quiet = false;                  // no per-trial lines or report listing (sweeps, tuning)
 };
 
 // Runs the batch (or this shard of it) and writes the reports. Returns the exit code: 0 when every

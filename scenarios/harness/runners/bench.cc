@@ -4,17 +4,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
-#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "loop/closed_loop.h"
-#include "loop/pilots.h"
 #include "loop/drive_plan.h"
+#include "loop/pilots.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 
@@ -31,8 +31,8 @@ sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double sc
   world.garden = options.garden;
   world.seed = 7;
   world.conditions.shadows = shadows;
-  sim::SimulatorConfig config =
-      MakeSimulatorConfig(options.paths, world, std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
+  sim::SimulatorConfig config = MakeSimulatorConfig(
+      options.paths, world, std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
   config.render_cameras = cameras;
   config.resolution_scale = scale;
   config.msaa_samples = msaa;
@@ -76,11 +76,13 @@ nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
   std::vector<std::unique_ptr<sim::Simulator>> simulators;
   std::vector<messages::RingRequest> requests;
   for (int r = 0; r < renderers; ++r) {
-    simulators.push_back(std::make_unique<sim::Simulator>(Config(options, true, v.scale, v.msaa, v.shadows, v.culling)));
+    simulators.push_back(
+        std::make_unique<sim::Simulator>(Config(options, true, v.scale, v.msaa, v.shadows, v.culling)));
     messages::RingRequest request = RequestFor(*simulators.back(), v);
     if (v.two_threads) {  // each renderer takes every other camera
       std::vector<int> mine;
-      for (std::size_t i = static_cast<std::size_t>(r); i < request.cameras.size(); i += 2) mine.push_back(request.cameras[i]);
+      for (std::size_t i = static_cast<std::size_t>(r); i < request.cameras.size(); i += 2)
+        mine.push_back(request.cameras[i]);
       request.cameras = mine;
     }
     requests.push_back(request);
@@ -126,10 +128,11 @@ nlohmann::json RenderCost(const BenchOptions& options, const RenderVariant& v) {
     const sim::SimulatorTimings after = simulators[0]->timings();
     out["stages_ms_per_ring"] = StageMs(before, after, options.frames);
     const long drawn = after.geoms_drawn - before.geoms_drawn, culled = after.geoms_culled - before.geoms_culled;
-    out["geoms_drawn_fraction"] = drawn + culled > 0 ? static_cast<double>(drawn) / static_cast<double>(drawn + culled) : 1.0;
+    out["geoms_drawn_fraction"] =
+        drawn + culled > 0 ? static_cast<double>(drawn) / static_cast<double>(drawn + culled) : 1.0;
   }
-  std::printf("  %-34s %2zu x %4dx%-4d  %7.1f ms/ring  %6.1f ms/camera", v.name.c_str(), cameras, out["width"].get<int>(),
-              out["height"].get<int>(), ring_ms, ring_ms / static_cast<double>(cameras));
+  std::printf("  %-34s %2zu x %4dx%-4d  %7.1f ms/ring  %6.1f ms/camera", v.name.c_str(), cameras,
+              out["width"].get<int>(), out["height"].get<int>(), ring_ms, ring_ms / static_cast<double>(cameras));
   if (!v.two_threads) {
     const auto& st = out["stages_ms_per_ring"];
     std::printf("  (draw %.1f, readback %.1f, distortion %.1f, exposure+noise %.1f; %.0f %% of the geoms drawn)",

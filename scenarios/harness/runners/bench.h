@@ -7,8 +7,8 @@ namespace trimbot::scenarios {
 
 struct BenchOptions {
   std::string garden = "test_lawn";
-  std::string output_path;   // JSON report
-  int frames = 5;            // ring frames per rendering measurement
+  std::string output_path;  // JSON report
+  int frames = 5;           // ring frames per rendering measurement
   double drive_seconds = 10.0;
   ProjectPaths paths;
 };

@@ -11,7 +11,6 @@
 namespace trimbot::scenarios {
 namespace {
 
-
 // A batch summary: `path` is an output folder of `trimbot run` or a summary JSON file.
 nlohmann::json ReadSummary(std::string* path) {
   if (std::filesystem::is_directory(*path)) *path += "/summary.json";
@@ -40,6 +39,5 @@ int RunCompare(CompareOptions options) {
   }
   return comparison.regressed ? 1 : 0;
 }
-
 
 }  // namespace trimbot::scenarios

@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "loop/closed_loop.h"
+#include "loop/drive_plan.h"
+#include "loop/pilots.h"
 #include "reports/run_log.h"
 #include "reports/run_timing.h"
-#include "loop/closed_loop.h"
-#include "loop/pilots.h"
-#include "loop/drive_plan.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/sim/simulator.h"
@@ -120,12 +120,14 @@ int RunDrive(const DriveOptions& options) {
   summary["status"] = failure.empty() ? "completed" : "failed";
   if (!failure.empty()) summary["error"] = failure;
   WriteFileAtomically(out + "/summary.json", summary.dump(2) + "\n");
-  const auto seconds = [](Clock::time_point from) { return std::chrono::duration<double>(Clock::now() - from).count(); };
+  const auto seconds = [](Clock::time_point from) {
+    return std::chrono::duration<double>(Clock::now() - from).count();
+  };
   const double wall = seconds(setup_start);
   const sim::SimulatorTimings sim_timing = simulator.timings();
-  const RunTiming timing = MakeRunTiming(wall, simulator.time(), sim_timing, &listener.telemetry().timings,
-                                         std::chrono::duration<double>(run_start - setup_start).count(),
-                                         seconds(report_start));
+  const RunTiming timing =
+      MakeRunTiming(wall, simulator.time(), sim_timing, &listener.telemetry().timings,
+                    std::chrono::duration<double>(run_start - setup_start).count(), seconds(report_start));
   const double render_seconds = sim_timing.render_draw + sim_timing.render_readback + sim_timing.distortion +
                                 sim_timing.exposure_noise + sim_timing.ground_truth;
   const double ms_per_frame = sim_timing.ring_frames > 0 ? 1000.0 * render_seconds / sim_timing.ring_frames : 0.0;
@@ -133,10 +135,11 @@ int RunDrive(const DriveOptions& options) {
   WriteRunTimingChart(out + "/timing.png", "where the drive's time went", timing);
 
   if (!options.quiet) {
-    std::printf("drive %s: %.1f s simulated in %.1f s (real-time factor %.2f), %ld ring frames (%.0f ms each), "
-                "odometry end error %.3f m\noutputs in %s\n",
-                failure.empty() ? "completed" : "FAILED", simulator.time(), wall, simulator.time() / wall, log.frames(),
-                ms_per_frame, summary["wheel_odometry_end_error_m"].get<double>(), out.c_str());
+    std::printf(
+        "drive %s: %.1f s simulated in %.1f s (real-time factor %.2f), %ld ring frames (%.0f ms each), "
+        "odometry end error %.3f m\noutputs in %s\n",
+        failure.empty() ? "completed" : "FAILED", simulator.time(), wall, simulator.time() / wall, log.frames(),
+        ms_per_frame, summary["wheel_odometry_end_error_m"].get<double>(), out.c_str());
     std::printf("%s", FormatRunTiming(timing).c_str());
   }
   if (!failure.empty()) {

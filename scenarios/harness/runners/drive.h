@@ -10,9 +10,9 @@ namespace trimbot::scenarios {
 struct DriveOptions {
   std::string plan_path;
   std::string output_dir;
-  std::optional<std::uint64_t> seed;        // overrides the plan's seed
-  std::optional<double> seconds;            // stop early
-  std::string calibration_path;             // empty: the nominal calibration
+  std::optional<std::uint64_t> seed;  // overrides the plan's seed
+  std::optional<double> seconds;      // stop early
+  std::string calibration_path;       // empty: the nominal calibration
   double resolution_scale = 1.0;
   int msaa_samples = 4;
   bool cameras = true;

@@ -7,11 +7,11 @@
 
 #include "evaluation/fusion_evaluator.h"
 #include "loop/closed_loop.h"
-#include "loop/pilots.h"
 #include "loop/drive_plan.h"
+#include "loop/pilots.h"
 #include "loop/world_setup.h"
-#include "trimbot/garden/garden.h"
 #include "trimbot/common/atomic_file.h"
+#include "trimbot/garden/garden.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
 
@@ -78,6 +78,5 @@ int RunFusionDrive(const FusionDriveOptions& options, const ProjectPaths& paths)
   WriteFileAtomically(options.out + "/fusion.json", summary.dump(2));
   return 0;
 }
-
 
 }  // namespace trimbot::scenarios

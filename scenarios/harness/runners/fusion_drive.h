@@ -14,7 +14,7 @@ struct FusionDriveOptions {
   std::string plan;  // drive plan (YAML)
   std::string out;   // fusion.json and the world go here
   perception::LocalFusionOptions fusion{true, 1.0, 4, 0.02};
-  int clouds = 20;   // registrations
+  int clouds = 20;  // registrations
 };
 
 // Prints each registration's errors and writes fusion.json; returns the exit code.

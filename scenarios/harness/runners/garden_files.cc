@@ -26,8 +26,8 @@ void Write(const std::string& path, const std::string& text) {
 int ImportGardenCsv(const std::string& csv, const std::string& name, double ground_z, const std::string& output) {
   garden::Garden garden = garden::ImportGardenUiCsv(csv, ground_z);
   garden.name = name;
-  Write(output, "# Imported from " + std::filesystem::path(csv).filename().string() + " by `trimbot garden import-csv`.\n" +
-                    garden.ToYaml());
+  Write(output, "# Imported from " + std::filesystem::path(csv).filename().string() +
+                    " by `trimbot garden import-csv`.\n" + garden.ToYaml());
   return 0;
 }
 

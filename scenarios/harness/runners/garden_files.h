@@ -19,11 +19,11 @@ int GenerateGardenFile(const garden::GeneratorParameters& parameters, const std:
                        const std::string& output);
 
 struct GardenExport {
-  std::string garden;        // name or file
+  std::string garden;  // name or file
   std::string output_dir;
-  double resolution = 0.05;  // m per occupancy cell
-  double clearance = 1.0;    // m: objects starting higher (tree crowns) are not obstacles
-  double growth = 0.0;       // seasonal growth 0..1 of the point cloud's foliage
+  double resolution = 0.05;      // m per occupancy cell
+  double clearance = 1.0;        // m: objects starting higher (tree crowns) are not obstacles
+  double growth = 0.0;           // seasonal growth 0..1 of the point cloud's foliage
   double point_density = 400.0;  // PLY points per m^2
 };
 // Writes <garden>_occupancy.{png,yaml} (map_server) and <garden>_ground_truth.ply.

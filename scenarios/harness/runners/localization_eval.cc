@@ -13,10 +13,10 @@
 
 #include "evaluation/pose_errors.h"
 #include "evaluation/trial_result.h"
-#include "reports/localization_timing.h"
 #include "loop/closed_loop.h"
-#include "loop/pilots.h"
 #include "loop/drive_plan.h"
+#include "loop/pilots.h"
+#include "reports/localization_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/overrides.h"
 #include "trimbot/common/random.h"
@@ -119,13 +119,20 @@ class NoisyPrior {
   double sigma_;
 };
 
-nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriveOptions& query, const QueryDrive& drive) {
-  return {{"map", options.map_path}, {"plan", query.plan_path}, {"seed", drive.world.seed},
-          {"time_of_day", drive.world.conditions.time_of_day}, {"day_of_year", drive.world.conditions.day_of_year},
-          {"growth", drive.world.conditions.growth}, {"lateral_offset_m", query.lateral_offset},
-          {"resolution_scale", *query.resolution_scale}, {"msaa_samples", query.msaa_samples},
+nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriveOptions& query,
+                         const QueryDrive& drive) {
+  return {{"map", options.map_path},
+          {"plan", query.plan_path},
+          {"seed", drive.world.seed},
+          {"time_of_day", drive.world.conditions.time_of_day},
+          {"day_of_year", drive.world.conditions.day_of_year},
+          {"growth", drive.world.conditions.growth},
+          {"lateral_offset_m", query.lateral_offset},
+          {"resolution_scale", *query.resolution_scale},
+          {"msaa_samples", query.msaa_samples},
           {"prior_sigma_m", options.prior_sigma},
-          {"stack_overrides", options.stack_overrides}, {"frames", drive.frames.size()}};
+          {"stack_overrides", options.stack_overrides},
+          {"frames", drive.frames.size()}};
 }
 
 }  // namespace
@@ -176,20 +183,21 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
                                      " frames, " + std::to_string(cv::getNumThreads()) + " threads)",
                                  timings);
   const auto& t = report["time"];
-  std::printf("[bench] %zu frames: fixes %.1f %% (within 25 cm %.1f %%), position error mean %.2f / median %.2f cm, "
-              "heading %.2f deg\n",
-              drive.frames.size(), 100 * fixes / n, 100 * within_25cm / n, 100 * position.mean, 100 * position.median,
-              heading.mean);
+  std::printf(
+      "[bench] %zu frames: fixes %.1f %% (within 25 cm %.1f %%), position error mean %.2f / median %.2f cm, "
+      "heading %.2f deg\n",
+      drive.frames.size(), 100 * fixes / n, 100 * within_25cm / n, 100 * position.mean, 100 * position.median,
+      heading.mean);
   std::printf("[bench] per frame (median): %.0f features, %.0f matches, %.0f inliers\n",
               ErrorStats::From(features).median, ErrorStats::From(matches).median, ErrorStats::From(inliers).median);
-  std::printf("[bench] ms per frame, median (p90): features %.1f (%.1f), retrieval %.1f (%.1f), matching %.1f (%.1f), "
-              "pose %.1f (%.1f); total %.1f (%.1f), mean %.1f\n",
-              t["features"]["median_ms"].get<double>(), t["features"]["p90_ms"].get<double>(),
-              t["retrieval"]["median_ms"].get<double>(), t["retrieval"]["p90_ms"].get<double>(),
-              t["matching"]["median_ms"].get<double>(), t["matching"]["p90_ms"].get<double>(),
-              t["pose"]["median_ms"].get<double>(), t["pose"]["p90_ms"].get<double>(),
-              t["total"]["median_ms"].get<double>(), t["total"]["p90_ms"].get<double>(),
-              t["total"]["mean_ms"].get<double>());
+  std::printf(
+      "[bench] ms per frame, median (p90): features %.1f (%.1f), retrieval %.1f (%.1f), matching %.1f (%.1f), "
+      "pose %.1f (%.1f); total %.1f (%.1f), mean %.1f\n",
+      t["features"]["median_ms"].get<double>(), t["features"]["p90_ms"].get<double>(),
+      t["retrieval"]["median_ms"].get<double>(), t["retrieval"]["p90_ms"].get<double>(),
+      t["matching"]["median_ms"].get<double>(), t["matching"]["p90_ms"].get<double>(),
+      t["pose"]["median_ms"].get<double>(), t["pose"]["p90_ms"].get<double>(), t["total"]["median_ms"].get<double>(),
+      t["total"]["p90_ms"].get<double>(), t["total"]["mean_ms"].get<double>());
   return 0;
 }
 
@@ -200,8 +208,9 @@ int RunRetrievalEval(const LocalizationEvalOptions& options) {
   const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
   NoisyPrior prior(drive.world.seed, options.prior_sigma);
   constexpr std::array<int, 3> kThresholds = {50, 100, 200};
-  const std::array<std::pair<Retrieval, const char*>, 3> methods = {
-      {{Retrieval::kVocabulary, "vocabulary"}, {Retrieval::kPosePrior, "pose_prior"}, {Retrieval::kCombined, "combined"}}};
+  const std::array<std::pair<Retrieval, const char*>, 3> methods = {{{Retrieval::kVocabulary, "vocabulary"},
+                                                                     {Retrieval::kPosePrior, "pose_prior"},
+                                                                     {Retrieval::kCombined, "combined"}}};
   // Per method: counts of (query image, keyframe) and (query rig, keyframe) pairs at each threshold.
   std::array<std::array<int, 3>, 3> image_hits{}, rig_hits{};
   std::array<int, 3> image_pairs{}, rig_pairs{};
@@ -219,17 +228,19 @@ int RunRetrievalEval(const LocalizationEvalOptions& options) {
         // Geometrically verified: inliers of the ring's pose from this keyframe's points alone.
         const auto correspondences = localizer->Match(features, {keyframe});
         const auto pose = visual_localization::EstimateRigPose(correspondences, localizer->T_base_camera(),
-                                                              localizer->options().pose);
+                                                               localizer->options().pose);
         std::vector<int> per_camera(static_cast<std::size_t>(cameras), 0);
         if (pose.success) {
-          for (int i : pose.inliers) ++per_camera[static_cast<std::size_t>(correspondences[static_cast<std::size_t>(i)].camera)];
+          for (int i : pose.inliers)
+            ++per_camera[static_cast<std::size_t>(correspondences[static_cast<std::size_t>(i)].camera)];
         }
         const int total = pose.success ? static_cast<int>(pose.inliers.size()) : 0;
         ++rig_pairs[m];
         image_pairs[m] += static_cast<int>(cameras_seen.size());
         for (std::size_t k = 0; k < kThresholds.size(); ++k) {
           rig_hits[m][k] += total >= kThresholds[k] ? 1 : 0;
-          for (int c : cameras_seen) image_hits[m][k] += per_camera[static_cast<std::size_t>(c)] >= kThresholds[k] ? 1 : 0;
+          for (int c : cameras_seen)
+            image_hits[m][k] += per_camera[static_cast<std::size_t>(c)] >= kThresholds[k] ? 1 : 0;
         }
       }
     }

@@ -18,16 +18,16 @@
 namespace trimbot::scenarios {
 
 struct QueryDriveOptions {
-  std::string plan_path;                  // drive plan (YAML)
-  std::optional<std::uint64_t> seed;      // default: the plan's + 2000 (other noise than a map's drive)
-  std::optional<double> time_of_day;      // h; default: the plan's
+  std::string plan_path;              // drive plan (YAML)
+  std::optional<std::uint64_t> seed;  // default: the plan's + 2000 (other noise than a map's drive)
+  std::optional<double> time_of_day;  // h; default: the plan's
   std::optional<int> day_of_year;
   std::optional<double> growth;
-  double lateral_offset = 0.0;            // m: the start moved to the left of its heading
-  std::optional<double> seconds;          // stop the drive early
-  double interval = 1.0;                  // s of simulated time between query frames
+  double lateral_offset = 0.0;             // m: the start moved to the left of its heading
+  std::optional<double> seconds;           // stop the drive early
+  double interval = 1.0;                   // s of simulated time between query frames
   std::optional<double> resolution_scale;  // default: what the stack asks for (its image_scale)
-  int msaa_samples = 4;                   // the renderer's anti-aliasing (as the trials render)
+  int msaa_samples = 4;                    // the renderer's anti-aliasing (as the trials render)
 };
 
 struct LocalizationEvalOptions {

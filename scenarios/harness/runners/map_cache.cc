@@ -1,16 +1,16 @@
 #include "runners/map_cache.h"
 
 #include <fcntl.h>
-#include <sys/wait.h>
 #include <sys/file.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -64,12 +64,15 @@ std::string BuilderSettings(const visual_localization::MapBuilderOptions& o) {
   out << "descriptor " << visual_localization::ToString(o.features.descriptor) << "\n"
       << "max_features " << o.features.max_features << "\n"
       << "keyframe_distance " << Number(o.keyframe_distance) << "\nkeyframe_angle " << Number(o.keyframe_angle) << "\n"
-      << "match_next_keyframes " << o.match_next_keyframes << "\nmax_camera_angle " << Number(o.max_camera_angle) << "\n"
+      << "match_next_keyframes " << o.match_next_keyframes << "\nmax_camera_angle " << Number(o.max_camera_angle)
+      << "\n"
       << "ratio " << Number(o.ratio) << "\nepipolar_angle " << Number(o.epipolar_angle) << "\n"
       << "survey_position_sigma " << Number(o.survey_position_sigma) << "\n"
       << "survey_rotation_sigma " << Number(o.survey_rotation_sigma) << "\n"
-      << "pixel_sigma " << Number(o.pixel_sigma) << "\nmax_reprojection_error " << Number(o.max_reprojection_error) << "\n"
-      << "min_triangulation_angle " << Number(o.min_triangulation_angle) << "\nmax_depth " << Number(o.max_depth) << "\n"
+      << "pixel_sigma " << Number(o.pixel_sigma) << "\nmax_reprojection_error " << Number(o.max_reprojection_error)
+      << "\n"
+      << "min_triangulation_angle " << Number(o.min_triangulation_angle) << "\nmax_depth " << Number(o.max_depth)
+      << "\n"
       << "vocabulary_words " << o.vocabulary_words << "\nadjustment_iterations " << o.adjustment_iterations << "\n";
   return out.str();
 }
@@ -144,8 +147,10 @@ void BuildInChildProcess(const MapBuildOptions& build) {
 
 std::string DefaultMapCacheDir() {
   if (const char* dir = std::getenv("TRIMBOT_MAP_CACHE"); dir != nullptr && *dir != '\0') return dir;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') return std::string(xdg) + "/trimbot/maps";
-  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') return std::string(home) + "/.cache/trimbot/maps";
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
+    return std::string(xdg) + "/trimbot/maps";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
+    return std::string(home) + "/.cache/trimbot/maps";
   return (fs::temp_directory_path() / "trimbot_maps").string();
 }
 
@@ -192,8 +197,8 @@ CachedMap EnsureCachedMap(const MapRecipe& recipe, const ProjectPaths& paths, co
   if (Holds(folder, key)) return cached;  // another process built it while we waited
 
   const auto start = std::chrono::steady_clock::now();
-  std::cout << "[map] no cached map of " << recipe.plan_path << " (key " << id << "): building it once into "
-            << folder << std::endl;
+  std::cout << "[map] no cached map of " << recipe.plan_path << " (key " << id << "): building it once into " << folder
+            << std::endl;
   const std::string staging = folder + ".building-" + std::to_string(getpid());
   fs::remove_all(staging);
   BuildInChildProcess(MapBuildOptions{recipe, staging, paths});
@@ -230,8 +235,9 @@ int EnsureScenarioMap(const std::string& scenario_path, const std::vector<std::s
   Scenario scenario = Scenario::Load(scenario_path, ParseOverrides(overrides));
   const auto map = ResolveVisualMap(scenario, paths);
   if (!map) {
-    throw InputError(scenario_path, "key 'visual_map': the scenario builds no map (it names a map file, or does not "
-                                    "localize visually)");
+    throw InputError(scenario_path,
+                     "key 'visual_map': the scenario builds no map (it names a map file, or does not "
+                     "localize visually)");
   }
   std::cout << "[map] " << (map->built ? "built" : "cached") << ": " << map->path << std::endl;
   return 0;

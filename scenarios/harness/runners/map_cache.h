@@ -19,9 +19,9 @@
 #include <optional>
 #include <string>
 
-#include "runners/mapping.h"
 #include "loop/scenario.h"
 #include "loop/world_setup.h"
+#include "runners/mapping.h"
 
 namespace trimbot::scenarios {
 

@@ -11,20 +11,20 @@
 #include <random>
 
 #include "evaluation/trial_result.h"
-#include "reports/map_plot.h"
 #include "loop/closed_loop.h"
-#include "loop/pilots.h"
 #include "loop/drive_plan.h"
+#include "loop/pilots.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "loop/simulated_pose_fixes.h"
-#include "trimbot/common/yaml_reader.h"
-#include "trimbot/stack/robot_stack.h"
+#include "reports/map_plot.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/random.h"
 #include "trimbot/common/rotation.h"
+#include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/robot_files.h"
+#include "trimbot/stack/robot_stack.h"
 #include "trimbot/visual_localization/map_builder.h"
 
 namespace trimbot::scenarios {
@@ -176,8 +176,8 @@ int RunMapBuild(const MapBuildOptions& options) {
               << static_cast<int>(std::chrono::duration<double>(Clock::now() - wall_start).count()) << " s elapsed"
               << std::endl;
   };
-  std::cout << "[map] driving " << options.recipe.plan_path << " (up to " << drive->duration << " s), rendering keyframes"
-            << std::endl;
+  std::cout << "[map] driving " << options.recipe.plan_path << " (up to " << drive->duration
+            << " s), rendering keyframes" << std::endl;
   RunClosedLoop(simulator, *drive->pilot, {&recorder}, loop);
   const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
@@ -186,8 +186,8 @@ int RunMapBuild(const MapBuildOptions& options) {
   visual_localization::MapBuildStats stats;
   const visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
   if (map.points.empty()) {
-    throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" + std::to_string(stats.keyframes) +
-                             " keyframes; too short, or nothing textured in view)");
+    throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" +
+                             std::to_string(stats.keyframes) + " keyframes; too short, or nothing textured in view)");
   }
   map.Save(options.out_dir + "/map.sqlite");
   const garden::OccupancyMap objects = garden::MakeOccupancyMap(simulator.garden(), 0.05, 1.0);
@@ -195,18 +195,27 @@ int RunMapBuild(const MapBuildOptions& options) {
                   "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
                       std::to_string(stats.keyframes) + " keyframes");
   const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  nlohmann::json report = {{"plan", options.recipe.plan_path}, {"garden", map.garden}, {"seed", world.seed},
+  nlohmann::json report = {{"plan", options.recipe.plan_path},
+                           {"garden", map.garden},
+                           {"seed", world.seed},
                            {"descriptor", visual_localization::ToString(map.descriptor)},
-                           {"frames_seen", stats.frames}, {"keyframes", stats.keyframes},
-                           {"images_matched", stats.images_matched}, {"matches", stats.matches},
-                           {"tracks", stats.tracks}, {"points", stats.points}, {"observations", stats.observations},
+                           {"frames_seen", stats.frames},
+                           {"keyframes", stats.keyframes},
+                           {"images_matched", stats.images_matched},
+                           {"matches", stats.matches},
+                           {"tracks", stats.tracks},
+                           {"points", stats.points},
+                           {"observations", stats.observations},
                            {"outlier_observations_dropped", stats.outlier_observations},
                            {"mean_track_length", stats.mean_track_length},
                            {"reprojection_rmse_px", stats.reprojection_rmse_px},
-                           {"seconds", {{"drive_and_render", drive_seconds - stats.seconds_features},
-                                        {"features", stats.seconds_features}, {"matching", stats.seconds_matching},
-                                        {"adjustment", stats.seconds_adjustment}, {"vocabulary", stats.seconds_vocabulary},
-                                        {"total", total_seconds}}},
+                           {"seconds",
+                            {{"drive_and_render", drive_seconds - stats.seconds_features},
+                             {"features", stats.seconds_features},
+                             {"matching", stats.seconds_matching},
+                             {"adjustment", stats.seconds_adjustment},
+                             {"vocabulary", stats.seconds_vocabulary},
+                             {"total", total_seconds}}},
                            {"keyframes_against_ground_truth", KeyframeErrors(map, survey)}};
   WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
   std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "

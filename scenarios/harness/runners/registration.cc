@@ -10,10 +10,10 @@
 #include <sstream>
 
 #include "evaluation/pose_errors.h"
-#include "runners/exit_code.h"
-#include "runners/registration_cv.h"
 #include "evaluation/registration_set.h"
 #include "evaluation/trial_result.h"
+#include "runners/exit_code.h"
+#include "runners/registration_cv.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/perception/registration.h"
 
@@ -27,7 +27,8 @@ double Median(const std::vector<double>& v) { return ErrorStats::From(v).median;
 perception::PointCloud EveryKth(const perception::PointCloud& cloud, int k) {
   if (k <= 1) return cloud;
   perception::PointCloud thinned;
-  for (std::size_t i = 0; i < cloud.size(); i += static_cast<std::size_t>(k)) thinned.Add(cloud.points[i], cloud.covariances[i]);
+  for (std::size_t i = 0; i < cloud.size(); i += static_cast<std::size_t>(k))
+    thinned.Add(cloud.points[i], cloud.covariances[i]);
   return thinned;
 }
 
@@ -44,7 +45,8 @@ int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::R
   out << std::left << std::setw(10) << "pair" << std::right << std::setw(8) << "|X|" << std::setw(8) << "|Y|"
       << std::setw(9) << "dropped" << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)" << std::setw(7)
       << "iters" << std::setw(10) << "time (s)" << std::setw(9) << "matched" << std::setw(6) << "conv" << std::setw(9)
-      << "cost" << std::setw(11) << "both ways" << std::setw(9) << "on surf" << "\n";
+      << "cost" << std::setw(11) << "both ways" << std::setw(9) << "on surf"
+      << "\n";
   std::vector<double> rotation, translation, seconds;
   int under_5_degrees = 0;
   int unregistered = 0;
@@ -71,8 +73,8 @@ int RegisterEach(const std::vector<RegistrationPair>& pairs, const perception::R
         << pair.y.size() << std::setw(9) << dropped << std::fixed << std::setprecision(2) << std::setw(11) << r
         << std::setprecision(3) << std::setw(11) << t << std::setw(7) << result.iterations << std::setw(10) << time
         << std::setprecision(2) << std::setw(9) << result.matched_fraction << std::setw(6) << result.converged
-        << std::setw(9) << result.final_cost << std::setw(11) << result.consistency_deg
-        << std::setw(9) << result.on_surface << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
+        << std::setw(9) << result.final_cost << std::setw(11) << result.consistency_deg << std::setw(9)
+        << result.on_surface << (result.trusted ? "" : "  untrusted: " + result.doubt) << "\n";
     if (show_starts) {
       for (std::size_t k = 0; k < result.starts.size(); ++k) {
         const perception::RegistrationStart& start = result.starts[k];
@@ -149,18 +151,17 @@ int RunRegister(const RegisterOptions& options) {
     unregistered = RegisterEach(pairs, registration, options.method, options.show_starts, std::cout);
   }
   if (bad_files + unregistered > 0) {
-    std::cerr << bad_files << " pair file(s) could not be read, " << unregistered << " pair(s) could not be registered\n";
+    std::cerr << bad_files << " pair file(s) could not be read, " << unregistered
+              << " pair(s) could not be registered\n";
   }
   return bad_files + unregistered > 0 ? kExitBadInput : kExitSuccess;
 }
-
 
 int RunRegistrationSet(const RegistrationSetOptions& options, const std::string& out, const ProjectPaths& paths) {
   fs::create_directories(out);
   const auto pairs = RenderRegistrationPairs(options, paths, out);
   for (const RegistrationPair& pair : pairs) WriteRegistrationPair(out + "/" + pair.name + ".txt", pair);
-  std::cout << pairs.size() << " pairs in " << out << " (register them: trimbot register " << out
-            << ")\n";
+  std::cout << pairs.size() << " pairs in " << out << " (register them: trimbot register " << out << ")\n";
   return pairs.size() == static_cast<std::size_t>(options.pairs) ? 0 : 1;
 }
 

@@ -16,12 +16,12 @@ namespace trimbot::scenarios {
 perception::RegistrationOptions FromTheIdentity();
 
 struct RegisterOptions {
-  std::string folder;               // of pair_NN.txt files
-  std::string method = "dugma";     // or an Open3D baseline: icp, icp_plane, gicp
-  std::vector<std::string> exclude; // pair names left out
-  int folds = 0;                    // > 0: cross-validated DUGMA (runners/registration_cv.h)
+  std::string folder;                    // of pair_NN.txt files
+  std::string method = "dugma";          // or an Open3D baseline: icp, icp_plane, gicp
+  std::vector<std::string> exclude;      // pair names left out
+  int folds = 0;                         // > 0: cross-validated DUGMA (runners/registration_cv.h)
   int thin_target = 1, thin_source = 1;  // keep every K-th point
-  bool show_starts = false;         // print each DUGMA start
+  bool show_starts = false;              // print each DUGMA start
   perception::RegistrationOptions registration = FromTheIdentity();
 };
 

@@ -50,7 +50,8 @@ Outcome Run(const RegistrationPair& pair, const perception::RegistrationOptions&
 
 // Lower is better: pairs at or over 5 deg first, then the median rotation error.
 std::pair<int, double> Score(const std::vector<double>& rotations) {
-  const int failures = static_cast<int>(std::count_if(rotations.begin(), rotations.end(), [](double r) { return r >= 5.0; }));
+  const int failures =
+      static_cast<int>(std::count_if(rotations.begin(), rotations.end(), [](double r) { return r >= 5.0; }));
   return {failures, ErrorStats::From(rotations).median};
 }
 
@@ -81,12 +82,14 @@ std::vector<CrossValidationRow> CrossValidateDugma(const std::vector<Registratio
     for (std::size_t p = 0; p < pairs.size(); ++p) {
       if (static_cast<int>(p % folds) != fold) continue;
       const Outcome& o = outcomes[best][p];
-      rows[p] = {pairs[p].name, fold, grid[best].name, o.rotation, o.translation, o.seconds, Run(pairs[p], icp).rotation};
+      rows[p] = {
+          pairs[p].name, fold, grid[best].name, o.rotation, o.translation, o.seconds, Run(pairs[p], icp).rotation};
     }
   }
   out << std::left << std::setw(10) << "pair" << std::right << std::setw(5) << "fold" << std::setw(20) << "parameters"
       << std::setw(11) << "rot (deg)" << std::setw(11) << "trans (m)" << std::setw(10) << "time (s)" << std::setw(11)
-      << "ICP (deg)" << "\n";
+      << "ICP (deg)"
+      << "\n";
   std::vector<double> rotation, translation, seconds;
   int under_5 = 0, worse_than_icp = 0;
   for (const CrossValidationRow& row : rows) {
@@ -103,9 +106,9 @@ std::vector<CrossValidationRow> CrossValidateDugma(const std::vector<Registratio
   }
   out << std::fixed << std::setprecision(3) << "cross-validated (" << folds << " folds, " << grid.size()
       << " candidates, chosen without the fold): median rotation " << ErrorStats::From(rotation).median
-      << " deg, translation " << ErrorStats::From(translation).median << " m, time "
-      << ErrorStats::From(seconds).median << " s; " << under_5 << " of " << rows.size() << " under 5 deg; "
-      << worse_than_icp << " worse than ICP by more than 2 deg\n";
+      << " deg, translation " << ErrorStats::From(translation).median << " m, time " << ErrorStats::From(seconds).median
+      << " s; " << under_5 << " of " << rows.size() << " under 5 deg; " << worse_than_icp
+      << " worse than ICP by more than 2 deg\n";
   return rows;
 }
 

@@ -15,9 +15,9 @@ namespace trimbot::scenarios {
 struct CrossValidationRow {
   std::string pair;
   int fold = 0;
-  std::string parameters;        // chosen on the other folds
+  std::string parameters;  // chosen on the other folds
   double rotation_deg = 0.0, translation_m = 0.0, seconds = 0.0;
-  double icp_rotation_deg = 0.0; // Open3D point-to-point ICP, same pair
+  double icp_rotation_deg = 0.0;  // Open3D point-to-point ICP, same pair
 };
 
 // `base`: the options every candidate starts from (method DUGMA); the grid varies neighbours,

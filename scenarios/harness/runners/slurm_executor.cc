@@ -87,12 +87,12 @@ void CheckOutputParent(const std::string& out_dir) {
 // One array task: a shard of one batch.
 struct Task {
   int batch = 0;
-  std::string dir;                   // the shard's output folder
-  std::string command;               // shell command line
+  std::string dir;      // the shard's output folder
+  std::string command;  // shell command line
   std::vector<int> trials;
   std::vector<std::uint64_t> seeds;
   int attempts = 0;
-  std::string failure;               // why the last attempt failed; empty when it succeeded
+  std::string failure;  // why the last attempt failed; empty when it succeeded
 };
 
 std::string CommandLine(const std::vector<std::string>& argv) {
@@ -114,12 +114,13 @@ std::string SubmitMissingMaps(const std::vector<BatchOptions>& batches, const st
     CheckWritableFolder(DefaultMapCacheDir(), "TRIMBOT_MAP_CACHE");
     const std::string id = MapCacheId(MapCacheKey(*recipe, paths));
     if (!submitted.insert(id).second) continue;
-    std::vector<std::string> ensure = {trimbot, "--data-root", paths.root, "map", "ensure",
-                                       fs::absolute(batches[b].scenario_path).string()};
+    std::vector<std::string> ensure = {trimbot, "--data-root", paths.root,
+                                       "map",   "ensure",      fs::absolute(batches[b].scenario_path).string()};
     for (const auto& o : batches[b].overrides) ensure.insert(ensure.end(), {"--set", o});
     std::vector<std::string> argv = sbatch_common;
-    argv.insert(argv.end(), {"--job-name=trimbot-map", "--output=" + work + "/logs/map_" + id + ".out",
-                             "--export=ALL,TRIMBOT_MAP_CACHE=" + DefaultMapCacheDir(), "--wrap=" + CommandLine(ensure)});
+    argv.insert(argv.end(),
+                {"--job-name=trimbot-map", "--output=" + work + "/logs/map_" + id + ".out",
+                 "--export=ALL,TRIMBOT_MAP_CACHE=" + DefaultMapCacheDir(), "--wrap=" + CommandLine(ensure)});
     std::string output;
     if (RunCommand(argv, output) != 0) throw std::runtime_error("sbatch of the map job failed: " + FirstLine(output));
     jobs.push_back(FirstLine(output).substr(0, FirstLine(output).find(';')));
@@ -131,11 +132,16 @@ std::string SubmitMissingMaps(const std::vector<BatchOptions>& batches, const st
 
 std::string ArrayScript(const std::string& work) {
   return "#!/bin/bash\n"
-         "# An array task of `trimbot` (scenarios/harness/runners/slurm_executor.h): runs line SLURM_ARRAY_TASK_ID + 1\n"
+         "# An array task of `trimbot` (scenarios/harness/runners/slurm_executor.h): runs line SLURM_ARRAY_TASK_ID + "
+         "1\n"
          "# of tasks.txt and records its exit code in status/.\n"
          "set -u\n"
-         "work=" + ShellQuote(work) + "\n"
-         "export TRIMBOT_MAP_CACHE=" + ShellQuote(DefaultMapCacheDir()) + "\n"
+         "work=" +
+         ShellQuote(work) +
+         "\n"
+         "export TRIMBOT_MAP_CACHE=" +
+         ShellQuote(DefaultMapCacheDir()) +
+         "\n"
          "command=$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" \"$work/tasks.txt\")\n"
          "eval \"$command\"\n"
          "code=$?\n"
@@ -202,11 +208,21 @@ std::vector<Task> PlanTasks(const std::vector<BatchOptions>& batches, const std:
         task.trials.push_back(i);
         task.seeds.push_back(seed + static_cast<std::uint64_t>(i));
       }
-      std::vector<std::string> argv = {options.trimbot, "--data-root", paths.root, "run",
-                                       fs::absolute(batch.scenario_path).string(), "--out", task.dir,
-                                       "--shard", std::to_string(shard) + "/" + std::to_string(shards),
-                                       "--trials", std::to_string(trials), "--seed", std::to_string(seed),
-                                       "--jobs", std::to_string(options.cpus_per_task)};
+      std::vector<std::string> argv = {options.trimbot,
+                                       "--data-root",
+                                       paths.root,
+                                       "run",
+                                       fs::absolute(batch.scenario_path).string(),
+                                       "--out",
+                                       task.dir,
+                                       "--shard",
+                                       std::to_string(shard) + "/" + std::to_string(shards),
+                                       "--trials",
+                                       std::to_string(trials),
+                                       "--seed",
+                                       std::to_string(seed),
+                                       "--jobs",
+                                       std::to_string(options.cpus_per_task)};
       for (const auto& o : batch.overrides) argv.insert(argv.end(), {"--set", o});
       task.command = CommandLine(argv);
       tasks.push_back(task);
@@ -252,7 +268,8 @@ std::vector<int> CollectFailures(std::vector<Task>& tasks, const std::vector<int
     if (tasks[i].failure.empty()) continue;
     failed.push_back(i);
     std::cout << "[slurm] task " << i << " (batch " << tasks[i].batch << ", trials";
-    for (std::size_t k = 0; k < tasks[i].trials.size(); ++k) std::cout << " " << tasks[i].trials[k] << " seed " << tasks[i].seeds[k];
+    for (std::size_t k = 0; k < tasks[i].trials.size(); ++k)
+      std::cout << " " << tasks[i].trials[k] << " seed " << tasks[i].seeds[k];
     std::cout << ") failed: " << tasks[i].failure << "; log " << work << "/logs/task_" << i << ".attempt_" << attempt
               << ".out" << (attempt < retries ? "; resubmitting" : "") << std::endl;
   }
@@ -262,8 +279,13 @@ std::vector<int> CollectFailures(std::vector<Task>& tasks, const std::vector<int
 void WriteTaskRecord(const std::vector<Task>& tasks, const std::string& path) {
   nlohmann::json record = nlohmann::json::array();
   for (std::size_t i = 0; i < tasks.size(); ++i) {
-    record.push_back({{"task", i}, {"batch", tasks[i].batch}, {"trials", tasks[i].trials}, {"seeds", tasks[i].seeds},
-                      {"attempts", tasks[i].attempts}, {"failure", tasks[i].failure}, {"command", tasks[i].command}});
+    record.push_back({{"task", i},
+                      {"batch", tasks[i].batch},
+                      {"trials", tasks[i].trials},
+                      {"seeds", tasks[i].seeds},
+                      {"attempts", tasks[i].attempts},
+                      {"failure", tasks[i].failure},
+                      {"command", tasks[i].command}});
   }
   WriteFileAtomically(path, record.dump(2));
 }
@@ -291,7 +313,8 @@ SlurmExecutor::SlurmExecutor(SlurmOptions options, ProjectPaths paths, const std
     : options_(std::move(options)), paths_(std::move(paths)) {
   const std::set<std::string> partitions = Partitions();
   if (!options_.partition.empty() && partitions.count(options_.partition) == 0) {
-    throw InputError("--partition", "partition '" + options_.partition + "' does not exist on this cluster (partitions: " +
+    throw InputError("--partition", "partition '" + options_.partition +
+                                        "' does not exist on this cluster (partitions: " +
                                         Joined({partitions.begin(), partitions.end()}, ", ") + ")");
   }
   if (options_.work_dir.empty()) throw InputError("--work-dir", "no work folder given");
@@ -350,7 +373,8 @@ std::vector<int> SlurmExecutor::Run(const std::vector<BatchOptions>& batches, co
   if (!pending.empty()) {
     std::cout << "[slurm] " << pending.size() << " tasks failed after " << options_.retries + 1
               << " attempts; their trials count as failed (seeds above; replay one with `trimbot run SCENARIO --seed "
-                 "SEED --trials 1`)" << std::endl;
+                 "SEED --trials 1`)"
+              << std::endl;
   }
   return codes;
 }

@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "runners/batch_executor.h"
 #include "loop/world_setup.h"
+#include "runners/batch_executor.h"
 
 namespace trimbot::scenarios {
 

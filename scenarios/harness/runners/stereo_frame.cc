@@ -10,10 +10,10 @@
 #include <filesystem>
 #include <sstream>
 
+#include "evaluation/stereo_evaluation.h"
 #include "loop/world_setup.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/perception/stereo.h"
-#include "evaluation/stereo_evaluation.h"
 #include "trimbot/sim/simulator.h"
 
 namespace trimbot::scenarios {
@@ -60,8 +60,7 @@ void WriteCloudPly(const std::string& path, const perception::PointCloud& cloud)
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d& p = cloud.points[i];
     const Eigen::Matrix3d& c = cloud.covariances[i];
-    std::snprintf(line, sizeof line, "%.4f %.4f %.4f %.4g %.4g %.4g\n", p.x(), p.y(), p.z(), c(0, 0), c(1, 1),
-                  c(2, 2));
+    std::snprintf(line, sizeof line, "%.4f %.4f %.4f %.4g %.4g %.4g\n", p.x(), p.y(), p.z(), c(0, 0), c(1, 1), c(2, 2));
     ply << line;
   }
   WriteFileAtomically(path, ply.str());
@@ -87,15 +86,16 @@ int RunStereoFrame(const StereoFrameOptions& options, const ProjectPaths& paths)
   const perception::RingStereo stereo(simulator.rig(), stereo_options);
   const int disparities = stereo_options.EffectiveDisparities();
   const perception::StereoRectifier& first = stereo.rectifiers().front();
-  std::printf("stereo: %s at (%.2f, %.2f) yaw %.1f deg, %d disparities (%s), OpenCV threads %d\n"
-              "rectified: f %.1f px, baseline %.4f m (f B %.2f px m), horizontal field of view %.1f deg\n",
-              options.garden.c_str(), options.x, options.y, options.yaw_degrees, disparities,
-              options.dense ? "8-path SGM" : "3-way SGM", cv::getNumThreads(), first.focal_length(),
-              first.baseline(), first.focal_length() * first.baseline(),
-              2.0 * std::atan(0.5 * first.image_size().width / first.focal_length()) * 180.0 / M_PI);
+  std::printf(
+      "stereo: %s at (%.2f, %.2f) yaw %.1f deg, %d disparities (%s), OpenCV threads %d\n"
+      "rectified: f %.1f px, baseline %.4f m (f B %.2f px m), horizontal field of view %.1f deg\n",
+      options.garden.c_str(), options.x, options.y, options.yaw_degrees, disparities,
+      options.dense ? "8-path SGM" : "3-way SGM", cv::getNumThreads(), first.focal_length(), first.baseline(),
+      first.focal_length() * first.baseline(),
+      2.0 * std::atan(0.5 * first.image_size().width / first.focal_length()) * 180.0 / M_PI);
   // spur %: estimates where the renderer saw nothing (sky), i.e. phantom points.
-  std::printf("%-5s %-10s %9s %8s %8s %8s %8s %8s %9s\n", "pair", "cameras", "time ms", "MAE px", "bad-1 %",
-              "bad-2 %", "compl %", "spur %", "points");
+  std::printf("%-5s %-10s %9s %8s %8s %8s %8s %8s %9s\n", "pair", "cameras", "time ms", "MAE px", "bad-1 %", "bad-2 %",
+              "compl %", "spur %", "points");
   stereo.ComputePair(capture.frame, 0);  // warm-up (OpenCV's threads, SGM buffers): not timed
   perception::PointCloud ring;
   double total_ms = 0.0;
@@ -110,9 +110,9 @@ int RunStereoFrame(const StereoFrameOptions& options, const ProjectPaths& paths)
     const StereoErrors errors = EvaluateDisparity(result.disparity, truth, disparities);
     const std::string cameras =
         "cam" + std::to_string(rectifier.pair().left) + "/cam" + std::to_string(rectifier.pair().right);
-    std::printf("%-5zu %-10s %9.1f %8.3f %8.2f %8.2f %8.1f %8.2f %9zu\n", k, cameras.c_str(), ms,
-                errors.mean_abs_error, errors.bad1_percent, errors.bad2_percent, errors.completeness_percent,
-                errors.spurious_percent, result.cloud.size());
+    std::printf("%-5zu %-10s %9.1f %8.3f %8.2f %8.2f %8.1f %8.2f %9zu\n", k, cameras.c_str(), ms, errors.mean_abs_error,
+                errors.bad1_percent, errors.bad2_percent, errors.completeness_percent, errors.spurious_percent,
+                result.cloud.size());
     const std::string prefix = options.output + "/pair" + std::to_string(k);
     WriteImage(prefix + "_disparity.png", ColouriseDisparity(result.disparity, disparities));
     const cv::Mat left_image = perception::ImageToMat(ImageOf(capture.frame, rectifier.pair().left));

@@ -10,12 +10,12 @@
 namespace trimbot::scenarios {
 
 struct StereoFrameOptions {
-  std::string garden;   // name or file
-  std::string output;   // folder
-  bool dense = false;   // 64 disparities, 8-path SGM instead of the robot's 32
+  std::string garden;  // name or file
+  std::string output;  // folder
+  bool dense = false;  // 64 disparities, 8-path SGM instead of the robot's 32
   std::uint64_t seed = 1;
   double x = 0.0, y = 0.0, yaw_degrees = 0.0;  // the robot in the map
-  int stride = 2;       // every n-th pixel into the cloud
+  int stride = 2;                              // every n-th pixel into the cloud
 };
 
 // Prints the errors per pair and writes the images and ring_cloud.ply; returns the exit code.

@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "evaluation/comparison.h"
-#include "reports/sweep_plot.h"
-#include "runners/batch_executor.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
+#include "reports/sweep_plot.h"
+#include "runners/batch_executor.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 
@@ -65,7 +65,8 @@ std::string Csv(const std::vector<SweepGrid>& grids, const json& points) {
   csv << std::setprecision(8) << "point";
   for (const auto& grid : grids) csv << "," << grid.key;
   const json& first = points.front()["metrics"];
-  for (const auto& [metric, unused] : first.items()) csv << "," << metric << "," << metric << "_low," << metric << "_high";
+  for (const auto& [metric, unused] : first.items())
+    csv << "," << metric << "," << metric << "_low," << metric << "_high";
   csv << "\n";
   for (const auto& p : points) {
     csv << p["index"].get<std::size_t>();
@@ -110,8 +111,8 @@ void WritePlots(const std::string& out, const std::string& scenario, const std::
         s.low[points[i][k]] = m["low"].get<double>();
         s.high[points[i][k]] = m["high"].get<double>();
       }
-      WriteSweepPlot(out + "/plots/" + metric + "_vs_" + grids[k].key + ".png", scenario + ": " + metric,
-                     grids[k].key, grids[k].values, metric, series);
+      WriteSweepPlot(out + "/plots/" + metric + "_vs_" + grids[k].key + ".png", scenario + ": " + metric, grids[k].key,
+                     grids[k].values, metric, series);
     }
   }
 }
@@ -169,15 +170,19 @@ int RunSweep(const SweepOptions& options) {
     const auto estimates = BatchEstimates(json::parse(in));
     point_results[i] = PointJson(grids, points[i], i, estimates);
     std::cout << "[sweep] point " << i;
-    for (std::size_t g = 0; g < grids.size(); ++g) std::cout << " " << grids[g].key << "=" << grids[g].values[points[i][g]];
-    std::cout << std::setprecision(4) << ": success " << estimates[0].value << " [" << estimates[0].interval.low
-              << ", " << estimates[0].interval.high << "], EKF error " << estimates[2].value << " m" << std::endl;
+    for (std::size_t g = 0; g < grids.size(); ++g)
+      std::cout << " " << grids[g].key << "=" << grids[g].values[points[i][g]];
+    std::cout << std::setprecision(4) << ": success " << estimates[0].value << " [" << estimates[0].interval.low << ", "
+              << estimates[0].interval.high << "], EKF error " << estimates[2].value << " m" << std::endl;
   });
   const json results = point_results;
   json grids_json;
   for (const auto& g : grids) grids_json[g.key] = g.values;
-  const json sweep = {{"scenario", name}, {"scenario_file", options.scenario_path}, {"overrides", options.overrides},
-                      {"grids", grids_json}, {"points", results}};
+  const json sweep = {{"scenario", name},
+                      {"scenario_file", options.scenario_path},
+                      {"overrides", options.overrides},
+                      {"grids", grids_json},
+                      {"points", results}};
   WriteFileAtomically(options.out_dir + "/sweep.json", sweep.dump(2));
   WriteFileAtomically(options.out_dir + "/sweep.csv", Csv(grids, results));
   WritePlots(options.out_dir, name, grids, points, results);

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "runners/batch_executor.h"
 #include "loop/world_setup.h"
+#include "runners/batch_executor.h"
 
 namespace trimbot::scenarios {
 
@@ -27,12 +27,12 @@ struct SweepOptions {
   std::string scenario_path;
   std::string out_dir;
   ProjectPaths paths;
-  std::vector<std::string> grids;       // key=v1,v2,...
-  std::vector<std::string> overrides;   // --set for every point
+  std::vector<std::string> grids;      // key=v1,v2,...
+  std::vector<std::string> overrides;  // --set for every point
   std::optional<int> trials;
   std::optional<std::uint64_t> seed;
   int jobs = DefaultJobs();
-  BatchExecutor* executor = nullptr;    // where the points run (null: here); all points at once
+  BatchExecutor* executor = nullptr;  // where the points run (null: here); all points at once
 };
 
 // Runs the sweep; returns 0 (a sweep reports, it does not judge). Bad input throws InputError.

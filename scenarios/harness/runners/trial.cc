@@ -6,14 +6,14 @@
 #include <optional>
 
 #include "evaluation/arm_reach.h"
-#include "loop/simulated_pose_fixes.h"
 #include "evaluation/trial_evaluator.h"
 #include "loop/closed_loop.h"
 #include "loop/pilots.h"
 #include "loop/prior_knowledge.h"
+#include "loop/simulated_pose_fixes.h"
 #include "reports/localization_timing.h"
-#include "reports/run_timing.h"
 #include "reports/output_files.h"
+#include "reports/run_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
@@ -73,7 +73,8 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   sim::Simulator simulator(PlantFor(setup, /*render_for_stack=*/true));
   const Eigen::Isometry3d T_map_base = simulator.ground_truth().T_map_base;
   ArmWorld world = MakeArmWorld(scenario, simulator, T_map_base);
-  const std::vector<ArmReachPose> poses = GenerateArmReachPoses(scenario, world, simulator.robot(), T_map_base, setup.seed);
+  const std::vector<ArmReachPose> poses =
+      GenerateArmReachPoses(scenario, world, simulator.robot(), T_map_base, setup.seed);
 
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
@@ -110,9 +111,9 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   const auto seconds = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
   const auto now = std::chrono::steady_clock::now();
   result.wall_seconds = seconds(wall_start, now);
-  const RunTiming run = MakeRunTiming(result.wall_seconds, result.simulated_seconds, simulator.timings(),
-                                      &robot.telemetry().timings, seconds(wall_start, loop_start),
-                                      seconds(report_start, now));
+  const RunTiming run =
+      MakeRunTiming(result.wall_seconds, result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
+                    seconds(wall_start, loop_start), seconds(report_start, now));
   WriteTiming(setup.dir, run, robot.telemetry().timings, result.arm_planning_seconds);
   return result;
 }
@@ -177,9 +178,9 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
   const auto seconds = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
   const auto now = std::chrono::steady_clock::now();
-  const RunTiming run = MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(),
-                                      &robot.telemetry().timings, seconds(wall_start, loop_start),
-                                      seconds(report_start, now));
+  const RunTiming run =
+      MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
+                    seconds(wall_start, loop_start), seconds(report_start, now));
   WriteTiming(setup.dir, run, robot.telemetry().timings, {});
   return result;
 }

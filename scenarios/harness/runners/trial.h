@@ -20,8 +20,8 @@ struct TrialSetup {
   const Scenario* scenario = nullptr;
   const TrialWorld* world = nullptr;  // the scenario's, prepared once for the batch
   ProjectPaths paths;
-  std::string map_yaml;   // the robot's prior map (map_server YAML)
-  std::string dir;        // this trial's output folder
+  std::string map_yaml;  // the robot's prior map (map_server YAML)
+  std::string dir;       // this trial's output folder
   int index = 0;
   std::uint64_t seed = 0;
 };

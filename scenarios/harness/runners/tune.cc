@@ -12,10 +12,10 @@
 #include <map>
 #include <sstream>
 
-#include "reports/sweep_plot.h"
-#include "runners/batch.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
+#include "reports/sweep_plot.h"
+#include "runners/batch.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/yaml_reader.h"
@@ -62,8 +62,8 @@ class Search {
     const std::vector<std::string> point = Point(x);
     const auto known = memory_.find(point);
     if (known != memory_.end()) return Sign() * known->second;
-    const double objective = RunPoint(point, options_.out_dir + "/evaluations/" + Index(evaluations_.size()),
-                                      options_.seed, nullptr);
+    const double objective =
+        RunPoint(point, options_.out_dir + "/evaluations/" + Index(evaluations_.size()), options_.seed, nullptr);
     memory_[point] = objective;
     evaluations_.push_back({point, objective});
     const double best = Best().objective;
@@ -215,12 +215,20 @@ int RunTune(const TuneOptions& options) {
   const bool better = search.Sign() * best_fresh < search.Sign() * default_fresh;
 
   json evaluations = json::array();
-  for (const auto& e : search.evaluations()) evaluations.push_back({{"overrides", e.overrides}, {"objective", e.objective}});
-  const json report = {{"scenario", scenario.name}, {"objective", options.objective}, {"maximize", options.maximize},
-                       {"method", options.method}, {"stop", stop}, {"trials_per_evaluation", trials},
-                       {"evaluations", evaluations}, {"best", {{"overrides", best.overrides}, {"tuned_seeds", best.objective},
-                                                               {"fresh_seeds", best_fresh}}},
-                       {"default_fresh_seeds", default_fresh}, {"fresh_seed", fresh}, {"improved_on_fresh_seeds", better}};
+  for (const auto& e : search.evaluations())
+    evaluations.push_back({{"overrides", e.overrides}, {"objective", e.objective}});
+  const json report = {
+      {"scenario", scenario.name},
+      {"objective", options.objective},
+      {"maximize", options.maximize},
+      {"method", options.method},
+      {"stop", stop},
+      {"trials_per_evaluation", trials},
+      {"evaluations", evaluations},
+      {"best", {{"overrides", best.overrides}, {"tuned_seeds", best.objective}, {"fresh_seeds", best_fresh}}},
+      {"default_fresh_seeds", default_fresh},
+      {"fresh_seed", fresh},
+      {"improved_on_fresh_seeds", better}};
   WriteFileAtomically(options.out_dir + "/tune.json", report.dump(2));
   WriteConvergencePlot(options.out_dir + "/convergence.png", options, search);
   std::cout << std::setprecision(5) << "[tune] " << stop << " after " << search.evaluations().size()

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "runners/batch_executor.h"
 #include "loop/world_setup.h"
+#include "runners/batch_executor.h"
 
 namespace trimbot::scenarios {
 
@@ -37,12 +37,12 @@ struct TuneSpace {
 struct TuneOptions {
   std::string scenario_path;
   std::string space_path;
-  std::string objective;               // a batch metric (summary.json "metrics")
+  std::string objective;  // a batch metric (summary.json "metrics")
   bool maximize = false;
-  std::string method = "bobyqa";       // bobyqa (local) | direct (global, DIRECT-L)
-  int budget_trials = 60;              // trials for the search (fresh-seed runs not counted)
-  std::optional<int> trials;           // per evaluation (default: the scenario's)
-  std::optional<std::uint64_t> seed;   // tuning seeds; fresh seeds start 1,000,000 higher
+  std::string method = "bobyqa";      // bobyqa (local) | direct (global, DIRECT-L)
+  int budget_trials = 60;             // trials for the search (fresh-seed runs not counted)
+  std::optional<int> trials;          // per evaluation (default: the scenario's)
+  std::optional<std::uint64_t> seed;  // tuning seeds; fresh seeds start 1,000,000 higher
   int jobs = DefaultJobs();
   std::string out_dir;
   ProjectPaths paths;

@@ -15,13 +15,15 @@ Eigen::VectorXd ToVector(const messages::ArmJointState& joints) {
 }  // namespace
 
 int BuildPerceivedEnvironment(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters,
-                              const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances,
+                              const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<Eigen::Matrix3d>& covariances,
                               robot::CollisionEnvironment* environment) {
   // The arm's base: the parent link of its first joint.
   const std::string arm_base_link = description.urdf().getJoint(robot::RobotFrames::ArmJoint(0))->parent_link_name;
   const Eigen::Vector3d arm_base = description.FramePose(arm_base_link).translation();
   const auto [low, high] = description.BaseOutline();
-  const Eigen::Vector2d body_min = low.array() - parameters.body_margin, body_max = high.array() + parameters.body_margin;
+  const Eigen::Vector2d body_min = low.array() - parameters.body_margin,
+                        body_max = high.array() + parameters.body_margin;
   // Points per cell, of those that can matter to the arm and are neither ground nor the robot.
   const double cell = parameters.cell;
   std::map<std::array<int, 3>, int> counts;
@@ -61,11 +63,16 @@ int BuildPerceivedEnvironment(const robot::RobotDescription& description, const 
 
 const char* ToString(ArmExecutive::Mode mode) {
   switch (mode) {
-    case ArmExecutive::Mode::kIdle: return "idle";
-    case ArmExecutive::Mode::kWaitingForEnvironment: return "waiting_for_environment";
-    case ArmExecutive::Mode::kMoving: return "moving";
-    case ArmExecutive::Mode::kSettling: return "settling";
-    case ArmExecutive::Mode::kDone: return "done";
+    case ArmExecutive::Mode::kIdle:
+      return "idle";
+    case ArmExecutive::Mode::kWaitingForEnvironment:
+      return "waiting_for_environment";
+    case ArmExecutive::Mode::kMoving:
+      return "moving";
+    case ArmExecutive::Mode::kSettling:
+      return "settling";
+    case ArmExecutive::Mode::kDone:
+      return "done";
   }
   return "?";
 }
@@ -99,7 +106,8 @@ void ArmExecutive::SetJointState(const messages::ArmJointState& joints) {
 
 void ArmExecutive::SetPerceivedPoints(const std::vector<Eigen::Vector3d>& points,
                                       const std::vector<Eigen::Matrix3d>& covariances) {
-  perceived_cells_ = BuildPerceivedEnvironment(description_, parameters_, points, covariances, &collision_->environment());
+  perceived_cells_ =
+      BuildPerceivedEnvironment(description_, parameters_, points, covariances, &collision_->environment());
   environment_ready_ = true;
   planner_->ResetRoadmap();
 }

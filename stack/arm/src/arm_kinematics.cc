@@ -9,8 +9,8 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -24,7 +24,8 @@ namespace {
 KDL::Frame ToKdl(const urdf::Pose& pose) {
   double x = 0, y = 0, z = 0, w = 1;
   pose.rotation.getQuaternion(x, y, z, w);
-  return KDL::Frame(KDL::Rotation::Quaternion(x, y, z, w), KDL::Vector(pose.position.x, pose.position.y, pose.position.z));
+  return KDL::Frame(KDL::Rotation::Quaternion(x, y, z, w),
+                    KDL::Vector(pose.position.x, pose.position.y, pose.position.z));
 }
 
 Eigen::Isometry3d ToEigen(const KDL::Frame& frame) {
@@ -67,7 +68,6 @@ std::array<double, 9> PoseFeature(const Eigen::Isometry3d& pose) {
   return {p.x(), p.y(), p.z(), x.x(), x.y(), x.z(), z.x(), z.y(), z.z()};
 }
 
-
 }  // namespace
 
 // Pre-computed solutions (the real robot's speed-up, D3.4 Section 1.5): joint configurations spread
@@ -79,9 +79,12 @@ struct SeedDatabase {
   size_t kdtree_get_point_count() const { return features.size(); }
   double kdtree_get_pt(size_t i, size_t d) const { return features[i][d]; }
   template <class Box>
-  bool kdtree_get_bbox(Box& /*box*/) const { return false; }
+  bool kdtree_get_bbox(Box& /*box*/) const {
+    return false;
+  }
 };
-using SeedTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SeedDatabase>, SeedDatabase, 9>;
+using SeedTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SeedDatabase>, SeedDatabase, 9>;
 
 struct ArmKinematics::Chain {
   KDL::Chain chain;
@@ -121,16 +124,19 @@ ArmKinematics::ArmKinematics(const robot::RobotDescription& description) : chain
         limit.upper = joint->limits->upper;
       }
       limit.velocity = joint->limits ? joint->limits->velocity : 0.0;
-      if (limit.velocity <= 0.0) throw InputError(description.path(), "joint '" + joint->name + "' has no velocity limit");
+      if (limit.velocity <= 0.0)
+        throw InputError(description.path(), "joint '" + joint->name + "' has no velocity limit");
       limits_.push_back(limit);
     } else if (joint->type != urdf::Joint::FIXED) {
-      throw InputError(description.path(), "joint '" + joint->name + "' of the arm chain is neither fixed nor revolute");
+      throw InputError(description.path(),
+                       "joint '" + joint->name + "' of the arm chain is neither fixed nor revolute");
     }
     chain_->chain.addSegment(KDL::Segment(joint->child_link_name, kdl_joint, origin));
     links_.push_back(joint->child_link_name);
   }
   if (limits_.size() != 6) {
-    throw InputError(description.path(), "the arm chain has " + std::to_string(limits_.size()) + " moving joints, not 6");
+    throw InputError(description.path(),
+                     "the arm chain has " + std::to_string(limits_.size()) + " moving joints, not 6");
   }
   chain_->fk = std::make_unique<KDL::ChainFkSolverPos_recursive>(chain_->chain);
   chain_->jacobian = std::make_unique<KDL::ChainJntToJacSolver>(chain_->chain);
@@ -279,8 +285,8 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
 }
 
 std::optional<Eigen::VectorXd> ArmKinematics::InverseKinematicsNear(const Eigen::Isometry3d& target,
-                                                                  const Eigen::VectorXd& seed,
-                                                                  const IkOptions& options) const {
+                                                                    const Eigen::VectorXd& seed,
+                                                                    const IkOptions& options) const {
   CheckSize(seed);
   KDL::ChainIkSolverPos_LMA solver(chain_->chain, 1e-12, options.max_iterations);
   KDL::JntArray solution(static_cast<unsigned>(joints()));

@@ -306,7 +306,8 @@ void ArmPlanner::SetWaypoints(const Eigen::VectorXd& start, const std::vector<Ei
   for (const Eigen::VectorXd& raw : states) {
     Eigen::VectorXd q = raw;
     for (int i = 0; i < q.size(); ++i) {
-      if (ompl_->continuous[static_cast<size_t>(i)]) q(i) = plan->waypoints.back()(i) + Wrap(raw(i) - plan->waypoints.back()(i));
+      if (ompl_->continuous[static_cast<size_t>(i)])
+        q(i) = plan->waypoints.back()(i) + Wrap(raw(i) - plan->waypoints.back()(i));
     }
     plan->waypoints.push_back(q);
   }
@@ -356,8 +357,8 @@ ArmPlan ArmPlanner::CartesianPass(const Eigen::VectorXd& start, const Eigen::Iso
   const Eigen::AngleAxisd turn(from.linear().transpose() * to.linear());
   const double distance = (to.translation() - from.translation()).norm();
   constexpr double kRadiansPerMetre = 10.0;  // a step turns the cutter at most 0.05 rad per 5 mm
-  const int steps = std::max(1, static_cast<int>(std::ceil(std::max(distance, turn.angle() / kRadiansPerMetre) /
-                                                           parameters_.cartesian_step)));
+  const int steps = std::max(
+      1, static_cast<int>(std::ceil(std::max(distance, turn.angle() / kRadiansPerMetre) / parameters_.cartesian_step)));
   plan.waypoints.push_back(start);
   for (int k = 1; k <= steps; ++k) {
     const double s = static_cast<double>(k) / steps;
@@ -375,12 +376,13 @@ ArmPlan ArmPlanner::CartesianPass(const Eigen::VectorXd& start, const Eigen::Iso
     } else if ((*q - previous).cwiseAbs().maxCoeff() > parameters_.cartesian_max_joint_step) {
       plan.failure = "the arm would switch branch" + at.str();
     } else {
-      const int checks = std::max(1, static_cast<int>(std::ceil((*q - previous).cwiseAbs().maxCoeff() /
-                                                                parameters_.collision_step)));
+      const int checks =
+          std::max(1, static_cast<int>(std::ceil((*q - previous).cwiseAbs().maxCoeff() / parameters_.collision_step)));
       for (int c = 1; c <= checks && plan.failure.empty(); ++c) {
         const robot::CollisionReport report = collision_.Check(previous + (*q - previous) * c / checks);
         ++plan.validity_checks;
-        if (report.collision) plan.failure = "collision (" + report.pair.first + " - " + report.pair.second + ")" + at.str();
+        if (report.collision)
+          plan.failure = "collision (" + report.pair.first + " - " + report.pair.second + ")" + at.str();
       }
     }
     if (!plan.failure.empty()) break;

@@ -18,9 +18,9 @@ constexpr int kX = 0, kY = 1, kYaw = 2, kV = 3, kW = 4, kBias = 5;
 
 // Prior on the states Initialize() is not told about. The first wheel speeds settle v and w at
 // once; the bias prior is a MEMS gyro's turn-on bias (about 1 deg/s).
-constexpr double kInitialSpeedSigma = 1.0;       // m/s
-constexpr double kInitialTurnRateSigma = 1.0;    // rad/s
-constexpr double kInitialGyroBiasSigma = 0.02;   // rad/s
+constexpr double kInitialSpeedSigma = 1.0;      // m/s
+constexpr double kInitialTurnRateSigma = 1.0;   // rad/s
+constexpr double kInitialGyroBiasSigma = 0.02;  // rad/s
 
 double WrapAngle(double angle) {
   double wrapped = std::remainder(angle, 2.0 * M_PI);  // [-pi, pi]
@@ -96,8 +96,8 @@ Matrix6 ProcessNoise(const Vector6& x, double dt, const EkfParameters& p) {
   return Q;
 }
 
-void Propagate(const Vector6& x, const Matrix6& P, double dt, const EkfParameters& parameters,
-               Vector6* x_out, Matrix6* P_out) {
+void Propagate(const Vector6& x, const Matrix6& P, double dt, const EkfParameters& parameters, Vector6* x_out,
+               Matrix6* P_out) {
   if (dt <= 0.0) {
     *x_out = x;
     *P_out = P;
@@ -177,9 +177,8 @@ void Ekf::AddWheelTicks(const messages::WheelTicks& ticks) {
     return;
   }
   const double dt = ticks.stamp - last_ticks_->stamp;
-  const robot::WheelSpeeds wheel_speeds{
-      static_cast<double>(ticks.left - last_ticks_->left) * radians_per_tick_ / dt,
-      static_cast<double>(ticks.right - last_ticks_->right) * radians_per_tick_ / dt};
+  const robot::WheelSpeeds wheel_speeds{static_cast<double>(ticks.left - last_ticks_->left) * radians_per_tick_ / dt,
+                                        static_cast<double>(ticks.right - last_ticks_->right) * radians_per_tick_ / dt};
   last_ticks_ = ticks;
   const WheelSpeedMeasurement speeds{geometry_.LinearFromWheels(wheel_speeds),
                                      geometry_.AngularFromWheels(wheel_speeds)};
@@ -347,8 +346,7 @@ bool Ekf::UpdateWheelSpeeds(const WheelSpeedMeasurement& m) {
   H(0, kV) = 1.0;
   H(1, kW) = 1.0;
   const Eigen::Vector2d innovation(m.linear - x_(kV), m.angular - x_(kW));
-  const Eigen::Matrix2d R =
-      Eigen::Vector2d(linear_sigma * linear_sigma, angular_sigma * angular_sigma).asDiagonal();
+  const Eigen::Matrix2d R = Eigen::Vector2d(linear_sigma * linear_sigma, angular_sigma * angular_sigma).asDiagonal();
   return KalmanUpdate<2>(innovation, H, R, &x_, &P_);
 }
 

@@ -16,11 +16,16 @@ double Saturate(double value, double low, double high) {
 
 const char* ToString(BushServo::Mode mode) {
   switch (mode) {
-    case BushServo::Mode::kIdle: return "idle";
-    case BushServo::Mode::kServoing: return "servoing";
-    case BushServo::Mode::kSettling: return "settling";
-    case BushServo::Mode::kDone: return "done";
-    case BushServo::Mode::kFailed: return "failed";
+    case BushServo::Mode::kIdle:
+      return "idle";
+    case BushServo::Mode::kServoing:
+      return "servoing";
+    case BushServo::Mode::kSettling:
+      return "settling";
+    case BushServo::Mode::kDone:
+      return "done";
+    case BushServo::Mode::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -119,7 +124,8 @@ messages::BaseVelocityCommand BushServo::Update(double stamp, const Pose2& odome
   mode_ = Mode::kServoing;
   stopped_since_ = -1.0;
   messages::BaseVelocityCommand command;
-  const double turn = Saturate(parameters_.turn_gain * bearing_error, parameters_.min_turn_rate, parameters_.max_turn_rate);
+  const double turn =
+      Saturate(parameters_.turn_gain * bearing_error, parameters_.min_turn_rate, parameters_.max_turn_rate);
   // Turn on the spot first when the bush is well off the bearing, then drive and steer.
   command.angular = std::abs(bearing_error) > parameters_.bearing_tolerance ? turn : 0.0;
   if (std::abs(bearing_error) <= parameters_.turn_first && std::abs(distance_error) > parameters_.distance_tolerance) {

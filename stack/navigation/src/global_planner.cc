@@ -49,8 +49,8 @@ class FootprintMotionValidator : public ob::MotionValidator {
       const double f = static_cast<double>(i) / steps;
       const Eigen::Vector2d q = a + f * (b - a);
       const bool check_footprint = length > 1e-9 && (q - start_).norm() > p.start_footprint_free;
-      const bool valid = planner_.Free(q) &&
-                         (!check_footprint || p.footprint.Clearance(planner_.map(), q.x(), q.y(), yaw) >= p.footprint_margin);
+      const bool valid = planner_.Free(q) && (!check_footprint || p.footprint.Clearance(planner_.map(), q.x(), q.y(),
+                                                                                        yaw) >= p.footprint_margin);
       if (!valid) {
         const double last = static_cast<double>(i - 1) / steps;
         if (last_valid.first != nullptr) si_->getStateSpace()->interpolate(s1, s2, last, last_valid.first);

@@ -14,21 +14,33 @@ namespace trimbot::stack {
 
 const char* ToString(NavigationEvent::Type type) {
   switch (type) {
-    case NavigationEvent::Type::kPlanned: return "planned";
-    case NavigationEvent::Type::kPlanFailed: return "plan_failed";
-    case NavigationEvent::Type::kGoalReached: return "goal_reached";
-    case NavigationEvent::Type::kGoalFailed: return "goal_failed";
-    case NavigationEvent::Type::kObstacleStop: return "obstacle_stop";
-    case NavigationEvent::Type::kRecovered: return "recovered";
-    case NavigationEvent::Type::kPathBlocked: return "path_blocked";
-    case NavigationEvent::Type::kGoalAdjusted: return "goal_adjusted";
-    case NavigationEvent::Type::kApproachReached: return "approach_reached";
+    case NavigationEvent::Type::kPlanned:
+      return "planned";
+    case NavigationEvent::Type::kPlanFailed:
+      return "plan_failed";
+    case NavigationEvent::Type::kGoalReached:
+      return "goal_reached";
+    case NavigationEvent::Type::kGoalFailed:
+      return "goal_failed";
+    case NavigationEvent::Type::kObstacleStop:
+      return "obstacle_stop";
+    case NavigationEvent::Type::kRecovered:
+      return "recovered";
+    case NavigationEvent::Type::kPathBlocked:
+      return "path_blocked";
+    case NavigationEvent::Type::kGoalAdjusted:
+      return "goal_adjusted";
+    case NavigationEvent::Type::kApproachReached:
+      return "approach_reached";
   }
   return "?";
 }
 
 Navigator::Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters)
-    : map_(map), costmap_(map), parameters_(parameters), planner_(costmap_, parameters.planner),
+    : map_(map),
+      costmap_(map),
+      parameters_(parameters),
+      planner_(costmap_, parameters.planner),
       follower_(parameters.follower) {}
 
 void Navigator::SetCostmap(OccupancyGrid costmap) {
@@ -139,7 +151,8 @@ std::string Navigator::DescribeBlock(const Eigen::Vector2d& blocked) const {
   for (int dr = -reach; dr <= reach; ++dr) {
     for (int dc = -reach; dc <= reach; ++dc) {
       const cv::Point cell(centre.x + dc, centre.y + dr);
-      if (cell.x < 0 || cell.y < 0 || cell.x >= costmap_.occupied().cols || cell.y >= costmap_.occupied().rows) continue;
+      if (cell.x < 0 || cell.y < 0 || cell.x >= costmap_.occupied().cols || cell.y >= costmap_.occupied().rows)
+        continue;
       if (costmap_.occupied().at<std::uint8_t>(cell) == 0 || map_.occupied().at<std::uint8_t>(cell) != 0) continue;
       const Eigen::Vector2d p = costmap_.CellCentre(cell);
       if ((p - blocked).norm() < nearest) {
@@ -149,8 +162,8 @@ std::string Navigator::DescribeBlock(const Eigen::Vector2d& blocked) const {
     }
   }
   std::ostringstream where;
-  where << std::fixed << std::setprecision(2) << "at (" << blocked.x() << " " << blocked.y()
-        << "), seen obstacle at (" << seen.x() << " " << seen.y() << ")";
+  where << std::fixed << std::setprecision(2) << "at (" << blocked.x() << " " << blocked.y() << "), seen obstacle at ("
+        << seen.x() << " " << seen.y() << ")";
   return where.str();
 }
 

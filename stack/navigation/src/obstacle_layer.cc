@@ -38,7 +38,8 @@ void ObstacleLayer::Recentre(const Eigen::Vector2d& centre) {
   const int x0 = std::max(0, dx), x1 = std::min(cells_, cells_ + dx);
   const int y0 = std::max(0, dy), y1 = std::min(cells_, cells_ + dy);
   if (x0 < x1 && y0 < y1) {
-    log_odds_(cv::Range(y0, y1), cv::Range(x0, x1)).copyTo(moved(cv::Range(y0 - dy, y1 - dy), cv::Range(x0 - dx, x1 - dx)));
+    log_odds_(cv::Range(y0, y1), cv::Range(x0, x1))
+        .copyTo(moved(cv::Range(y0 - dy, y1 - dy), cv::Range(x0 - dx, x1 - dx)));
   }
   log_odds_ = moved;
   origin_ = snapped;

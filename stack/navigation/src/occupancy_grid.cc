@@ -28,7 +28,8 @@ OccupancyGrid OccupancyGrid::LoadMapServer(const std::string& yaml_path) {
   std::filesystem::path image_path(image_name);
   if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
   const cv::Mat grey = cv::imread(image_path.string(), cv::IMREAD_GRAYSCALE);
-  if (grey.empty()) throw InputError(image_path.string(), "cannot read the map image (referenced by " + yaml_path + ")");
+  if (grey.empty())
+    throw InputError(image_path.string(), "cannot read the map image (referenced by " + yaml_path + ")");
 
   // map_server: p = (255 - value) / 255 is the occupancy probability (value / 255 when negated).
   cv::Mat occupied(grey.size(), CV_8U);
@@ -78,8 +79,8 @@ double OccupancyGrid::DistanceToObstacle(const Eigen::Vector2d& point) const {
   const double fx = std::clamp(local.x() - c0, 0.0, 1.0);
   const double fy = std::clamp(local.y() - y0, 0.0, 1.0);
   auto at = [&](int c, int y) { return static_cast<double>(distance_.at<float>(distance_.rows - 1 - y, c)); };
-  const double d = (1 - fx) * (1 - fy) * at(c0, y0) + fx * (1 - fy) * at(c1, y0) + (1 - fx) * fy * at(c0, y1) +
-                   fx * fy * at(c1, y1);
+  const double d =
+      (1 - fx) * (1 - fy) * at(c0, y0) + fx * (1 - fy) * at(c1, y0) + (1 - fx) * fy * at(c0, y1) + fx * fy * at(c1, y1);
   // Inside an occupied cell the distance is 0 whatever the neighbours say.
   const cv::Point cell = Cell(point);
   return occupied_.at<uchar>(cell.y, cell.x) ? 0.0 : d;

@@ -76,12 +76,13 @@ double Residual(const BushPoint& point, const BushShape& shape, const Eigen::Vec
 }
 
 // Solves for centre and scale from their current values; false if Ceres gives no usable solution.
-bool Solve(const std::vector<BushPoint>& points, const BushShape& shape, const BushFitOptions& options,
-           bool fit_scale, Eigen::Vector2d* centre, double* scale) {
+bool Solve(const std::vector<BushPoint>& points, const BushShape& shape, const BushFitOptions& options, bool fit_scale,
+           Eigen::Vector2d* centre, double* scale) {
   ceres::Problem problem;
   for (const BushPoint& point : points) {
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SurfaceResidual, 1, 2, 1>(new SurfaceResidual(point, shape)),
-                             new ceres::HuberLoss(options.huber), centre->data(), scale);
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<SurfaceResidual, 1, 2, 1>(new SurfaceResidual(point, shape)),
+        new ceres::HuberLoss(options.huber), centre->data(), scale);
   }
   if (fit_scale) {
     // The surveyed size weighs as much as the points: stereo's errors are correlated over a

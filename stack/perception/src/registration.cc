@@ -1,5 +1,5 @@
-#include "trimbot/common/rotation.h"
 #include "trimbot/perception/registration.h"
+#include "trimbot/common/rotation.h"
 
 #include "open3d_icp.h"
 
@@ -9,12 +9,12 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
-#include <limits>
-#include <sstream>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <unordered_map>
 #include <vector>
 
@@ -34,8 +34,8 @@ struct PointsAdaptor {
     return false;
   }
 };
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 3,
-                                                   std::uint32_t>;
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor,
+                                                   3, std::uint32_t>;
 
 // The target at one resolution: while the annealing spread is wide, the E-step meets a coarser
 // version of the target, so its k nearest points still cover a few spreads (a fixed k on the full
@@ -191,7 +191,8 @@ void SurfaceCovariances(double along, const LocalSurface& surface, PointCloud* c
     const Eigen::Vector3d& normal = surface.normals[i];
     if (normal.isZero()) continue;
     const Eigen::Matrix3d across = normal * normal.transpose();
-    cloud->covariances[i] = along * along * (Eigen::Matrix3d::Identity() - across) + surface.normal_variances[i] * across;
+    cloud->covariances[i] =
+        along * along * (Eigen::Matrix3d::Identity() - across) + surface.normal_variances[i] * across;
   }
 }
 
@@ -199,11 +200,11 @@ void SurfaceCovariances(double along, const LocalSurface& surface, PointCloud* c
 // levels of the target (with a k-d tree each) and of the source.
 struct Prepared {
   PointCloud target, source;
-  double point_spacing = 0.0;           // median nearest-neighbour distance in the target
+  double point_spacing = 0.0;  // median nearest-neighbour distance in the target
   double source_spacing = 0.0;
-  bool isotropic = true;                // every covariance is c I
+  bool isotropic = true;  // every covariance is c I
   double typical_target_variance = 0.0;
-  std::deque<TargetLevel> levels;       // a deque: growing it never moves a level its tree points into
+  std::deque<TargetLevel> levels;  // a deque: growing it never moves a level its tree points into
   std::vector<PointCloud> source_levels;
   // The full source with its own tree, and both clouds' local surfaces with the sensor's variance
   // across them (before any surface patch): what FitBothWays judges a result by.
@@ -275,7 +276,6 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
     p->source_levels[0] = std::move(thinned);
   }
   for (std::size_t l = 1; l < p->levels.size(); ++l) p->source_levels[l] = VoxelDownsample(source, p->levels[l].voxel);
-
 }
 
 // The RMS distance of the points from their centroid: the cloud's size.
@@ -342,7 +342,8 @@ struct EStep {
         m = d.squaredNorm() / c;
         determinant = c * c * c;
       } else {
-        const Eigen::Matrix3d C = level.cloud.covariances[index[n]] + source_cov + spread2 * Eigen::Matrix3d::Identity();
+        const Eigen::Matrix3d C =
+            level.cloud.covariances[index[n]] + source_cov + spread2 * Eigen::Matrix3d::Identity();
         informations[n] = C.inverse();
         m = d.dot(informations[n] * d);
         determinant = C.determinant();
@@ -407,7 +408,8 @@ Eigen::Isometry3d MStep(const std::vector<SourceTerms>& terms, const PointCloud&
   }
   if (pairs == 0) return next;
   if (translation_only) {
-    const Eigen::Vector3d delta = -(H.bottomRightCorner<3, 3>() + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(g.tail<3>());
+    const Eigen::Vector3d delta =
+        -(H.bottomRightCorner<3, 3>() + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(g.tail<3>());
     if (delta.allFinite()) next.translation() = T.translation() + delta;
     return next;
   }
@@ -427,17 +429,24 @@ namespace {
 // covariances rule: fills the result's transform and the EM's state (iterations, cost, pairs,
 // matched fraction). While the spread is wider than `turn_below` only the translation moves (a
 // heading start keeps its heading until the clouds overlap). The fine fit is PolishOnSurface's.
-void RunEm(const Prepared& p, const RegistrationOptions& options, double anneal, Eigen::Isometry3d T,
-           double turn_below, RegistrationResult* result) {
+void RunEm(const Prepared& p, const RegistrationOptions& options, double anneal, Eigen::Isometry3d T, double turn_below,
+           RegistrationResult* result) {
   std::vector<SourceTerms> terms;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     // The coarsest target whose voxels are no wider than the spread.
     std::size_t level_index = 0;
     while (level_index + 1 < p.levels.size() && p.levels[level_index + 1].voxel <= anneal) ++level_index;
     const PointCloud& moving = p.source_levels[level_index];
-    const EStep e{p.levels[level_index], moving, T.linear(), T.translation(), p.isotropic,
-                  std::max(1, options.neighbours), 2.0 * anneal * anneal,
-                  options.truncation_sigmas * options.truncation_sigmas, p.typical_target_variance, options.outlier_weight};
+    const EStep e{p.levels[level_index],
+                  moving,
+                  T.linear(),
+                  T.translation(),
+                  p.isotropic,
+                  std::max(1, options.neighbours),
+                  2.0 * anneal * anneal,
+                  options.truncation_sigmas * options.truncation_sigmas,
+                  p.typical_target_variance,
+                  options.outlier_weight};
     terms.resize(moving.size());
     // E-step, in parallel over source points; each writes only its own terms (deterministic).
 #pragma omp parallel for schedule(static)
@@ -458,7 +467,8 @@ void RunEm(const Prepared& p, const RegistrationOptions& options, double anneal,
     T = next;
     result->final_cost = matched > 0 ? cost / matched : 0.0;
     result->pairs = pairs;
-    result->matched_fraction = static_cast<double>(matched) / static_cast<double>(std::max<std::size_t>(1, moving.size()));
+    result->matched_fraction =
+        static_cast<double>(matched) / static_cast<double>(std::max<std::size_t>(1, moving.size()));
     if (anneal == 0.0) break;
     anneal *= options.anneal_factor;
     if (anneal < 0.5 * p.point_spacing) anneal = 0.0;  // below the point spacing the points' own covariances rule
@@ -585,7 +595,7 @@ Eigen::Vector3d DominantNormal(const LocalSurface& surface, double min_support) 
   const double cos_tolerance = std::cos(10.0 * M_PI / 180.0);
   const std::size_t n = surface.normals.size();
   const std::size_t candidates = std::max<std::size_t>(1, n / 100);  // every k-th normal is a candidate
-  const std::size_t sample = std::max<std::size_t>(1, n / 3000);      // and is tested on every k-th
+  const std::size_t sample = std::max<std::size_t>(1, n / 3000);     // and is tested on every k-th
   std::size_t best_support = 0;
   Eigen::Vector3d best = Eigen::Vector3d::Zero();
   for (std::size_t c = 0; c < n; c += candidates) {
@@ -617,8 +627,8 @@ RegistrationStart RunStart(const Prepared& p, const RegistrationOptions& options
 }  // namespace
 
 namespace {
-RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
-                                const RegistrationOptions& options);
+RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in,
+                                const Eigen::Isometry3d& initial, const RegistrationOptions& options);
 }  // namespace
 
 RegistrationResult Register(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
@@ -644,8 +654,8 @@ RegistrationResult Register(const PointCloud& target_in, const PointCloud& sourc
 
 namespace {
 
-RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in, const Eigen::Isometry3d& initial,
-                                const RegistrationOptions& options) {
+RegistrationResult RegisterOnce(const PointCloud& target_in, const PointCloud& source_in,
+                                const Eigen::Isometry3d& initial, const RegistrationOptions& options) {
   if (!initial.matrix().allFinite()) throw RegistrationError("registration: the initial guess is not finite");
   RegistrationResult result;
   Prepared p;

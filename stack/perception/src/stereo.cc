@@ -143,8 +143,8 @@ StereoMatcher::StereoMatcher(const StereoOptions& options) : options_(options), 
   }
   const int area = options.block_size * options.block_size;  // grey images: one channel
   impl_->sgbm = cv::StereoSGBM::create(/*minDisparity=*/0, disparities, options.block_size, 8 * area, 32 * area,
-                                       options.max_left_right_difference, /*preFilterCap=*/63,
-                                       options.uniqueness_ratio, options.speckle_window, options.speckle_range,
+                                       options.max_left_right_difference, /*preFilterCap=*/63, options.uniqueness_ratio,
+                                       options.speckle_window, options.speckle_range,
                                        options.dense ? cv::StereoSGBM::MODE_HH : cv::StereoSGBM::MODE_SGBM_3WAY);
 }
 

@@ -17,11 +17,15 @@ Eigen::Vector2d Apply(const Eigen::Isometry3d& T, const Eigen::Vector2d& p) {
 
 MissionState ToMission(Navigator::Mode mode) {
   switch (mode) {
-    case Navigator::Mode::kIdle: return MissionState::kIdle;
+    case Navigator::Mode::kIdle:
+      return MissionState::kIdle;
     case Navigator::Mode::kFollowing:
-    case Navigator::Mode::kBackingOff: return MissionState::kDriving;
-    case Navigator::Mode::kDone: return MissionState::kDone;
-    case Navigator::Mode::kFailed: return MissionState::kFailed;
+    case Navigator::Mode::kBackingOff:
+      return MissionState::kDriving;
+    case Navigator::Mode::kDone:
+      return MissionState::kDone;
+    case Navigator::Mode::kFailed:
+      return MissionState::kFailed;
   }
   return MissionState::kIdle;
 }
@@ -30,11 +34,16 @@ MissionState ToMission(Navigator::Mode mode) {
 
 const char* ToString(MissionState state) {
   switch (state) {
-    case MissionState::kIdle: return "idle";
-    case MissionState::kDriving: return "driving";
-    case MissionState::kReaching: return "reaching";
-    case MissionState::kDone: return "done";
-    case MissionState::kFailed: return "failed";
+    case MissionState::kIdle:
+      return "idle";
+    case MissionState::kDriving:
+      return "driving";
+    case MissionState::kReaching:
+      return "reaching";
+    case MissionState::kDone:
+      return "done";
+    case MissionState::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -105,8 +114,8 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
     if (best) return *best;
   }
   // No side is free: straight from where the robot comes (the navigator moves the point or says why).
-  const Eigen::Vector2d away = (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized()
-                                                                      : Eigen::Vector2d(-1.0, 0.0);
+  const Eigen::Vector2d away =
+      (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized() : Eigen::Vector2d(-1.0, 0.0);
   return goal.position + reach * away;
 }
 

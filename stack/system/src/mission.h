@@ -85,7 +85,7 @@ class Mission {
   bool servoing_ = false;
   bool failed_ = false;
   BushApproachStatus bush_status_;
-  bool arm_goals_ = false;  // SetArmGoals was given goals
+  bool arm_goals_ = false;                    // SetArmGoals was given goals
   MissionState state_ = MissionState::kIdle;  // as reported in the telemetry
 };
 

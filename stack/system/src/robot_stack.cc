@@ -42,8 +42,8 @@ struct RobotStack::Components {
 };
 
 std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const std::string& map_path,
-                                                                         const VisualLocalizationParameters& v,
-                                                                         const robot::CameraRig& rig) {
+                                                                          const VisualLocalizationParameters& v,
+                                                                          const robot::CameraRig& rig) {
   visual_localization::LocalizerOptions options;
   options.features.max_features = v.features;
   options.features.descriptor = v.descriptor;
@@ -64,8 +64,9 @@ RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& pa
     : parameters_(parameters), components_(std::make_unique<Components>(files, parameters_, seed)) {
   SeedPlanner(seed);
   if (components_->obstacles.enabled() && components_->obstacles.PairsAhead(0.0).empty()) {
-    throw std::invalid_argument("stack parameters: perception.obstacles.max_bearing_deg leaves no stereo pair "
-                                "facing forward");
+    throw std::invalid_argument(
+        "stack parameters: perception.obstacles.max_bearing_deg leaves no stereo pair "
+        "facing forward");
   }
   // The standoff must leave the footprint's front clear of the bush's surveyed outline.
   const Footprint& footprint = parameters_.navigation.planner.footprint;

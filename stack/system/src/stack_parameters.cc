@@ -286,9 +286,12 @@ void Read(Reader& r, StackParameters& s) {
 
 const char* ToString(LocalizationSource source) {
   switch (source) {
-    case LocalizationSource::kNone: return "none";
-    case LocalizationSource::kSimulatedPoseFixes: return "simulated_pose_fixes";
-    case LocalizationSource::kVisual: return "visual";
+    case LocalizationSource::kNone:
+      return "none";
+    case LocalizationSource::kSimulatedPoseFixes:
+      return "simulated_pose_fixes";
+    case LocalizationSource::kVisual:
+      return "visual";
   }
   return "?";
 }

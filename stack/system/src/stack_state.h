@@ -30,10 +30,10 @@ struct StackState {
   WheelOdometry odometry;
   GyroOdometry servo_odometry;  // the bush servo's frame
   Ekf ekf;
-  Pose2 odom_origin;            // map pose of the odom frame
+  Pose2 odom_origin;  // map pose of the odom frame
   std::unique_ptr<OccupancyGrid> map;
   std::unique_ptr<Navigator> navigator;  // made with the map
-  Eigen::Vector2d arm_axis;     // base_link: the arm's base (the ring's centre)
+  Eigen::Vector2d arm_axis;              // base_link: the arm's base (the ring's centre)
   arm::ArmExecutive arm;
   Mission mission;
   double last_linear_command = 0.0;  // m/s: its sign is the direction of travel

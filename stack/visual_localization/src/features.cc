@@ -8,9 +8,7 @@
 
 namespace trimbot::visual_localization {
 
-const char* ToString(Descriptor descriptor) {
-  return descriptor == Descriptor::kUprightSift ? "upright_sift" : "sift";
-}
+const char* ToString(Descriptor descriptor) { return descriptor == Descriptor::kUprightSift ? "upright_sift" : "sift"; }
 
 Descriptor DescriptorFromString(const std::string& name) {
   if (name == "upright_sift") return Descriptor::kUprightSift;
@@ -19,7 +17,8 @@ Descriptor DescriptorFromString(const std::string& name) {
 }
 
 Features ExtractFeatures(const cv::Mat& grey, const FeatureOptions& options) {
-  if (grey.empty() || grey.type() != CV_8UC1) throw std::invalid_argument("ExtractFeatures: expects an 8-bit grey image");
+  if (grey.empty() || grey.type() != CV_8UC1)
+    throw std::invalid_argument("ExtractFeatures: expects an 8-bit grey image");
   const cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
   Features f;
   if (options.descriptor == Descriptor::kSift) {

@@ -32,7 +32,8 @@ std::vector<std::array<int, 2>> TwoNearestWords(const cv::Mat& descriptors, cons
       cv::BFMatcher(cv::NORM_L2).knnMatch(descriptors.rowRange(begin, end), vocabulary, nearest, 2);
       for (int i = begin; i < end; ++i) {
         const auto& pair = nearest[static_cast<std::size_t>(i - begin)];
-        words[static_cast<std::size_t>(i)] = {pair.at(0).trainIdx, pair.size() > 1 ? pair[1].trainIdx : pair[0].trainIdx};
+        words[static_cast<std::size_t>(i)] = {pair.at(0).trainIdx,
+                                              pair.size() > 1 ? pair[1].trainIdx : pair[0].trainIdx};
       }
     }
   });
@@ -48,7 +49,8 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
   for (const auto& k : map_.keyframes) max_id = std::max(max_id, k.id);
   keyframe_points_.resize(static_cast<std::size_t>(max_id + 1));
   for (const auto& o : map_.observations) {
-    if (o.keyframe >= 0 && o.keyframe <= max_id) keyframe_points_[static_cast<std::size_t>(o.keyframe)].push_back(o.point);
+    if (o.keyframe >= 0 && o.keyframe <= max_id)
+      keyframe_points_[static_cast<std::size_t>(o.keyframe)].push_back(o.point);
   }
   for (auto& points : keyframe_points_) {
     std::sort(points.begin(), points.end());
@@ -60,7 +62,8 @@ VisualLocalizer::VisualLocalizer(VisualMap map, const robot::CameraRig& rig, con
   cv::Mat raw(static_cast<int>(keyframe_points_.size()), words, CV_32F, cv::Scalar(0));
   for (const auto& nearest : TwoNearestWords(map_.descriptors, map_.vocabulary)) point_words_.push_back(nearest[0]);
   for (std::size_t k = 0; k < keyframe_points_.size(); ++k) {
-    for (int p : keyframe_points_[k]) raw.at<float>(static_cast<int>(k), point_words_[static_cast<std::size_t>(p)]) += 1.0f;
+    for (int p : keyframe_points_[k])
+      raw.at<float>(static_cast<int>(k), point_words_[static_cast<std::size_t>(p)]) += 1.0f;
   }
   idf_ = cv::Mat(1, words, CV_32F);
   for (int w = 0; w < words; ++w) {
@@ -128,8 +131,8 @@ void VisualLocalizer::AssignWords(FrameFeatures* features) const {
 }
 
 std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
-                                           const std::optional<Eigen::Vector2d>& prior_position,
-                                           Retrieval method, int count) const {
+                                           const std::optional<Eigen::Vector2d>& prior_position, Retrieval method,
+                                           int count) const {
   const bool use_prior = prior_position && method != Retrieval::kVocabulary;
   const bool use_words = method != Retrieval::kPosePrior || !prior_position;
   const cv::Mat query = use_words ? WordHistogram(features) : cv::Mat();
@@ -137,7 +140,8 @@ std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
   for (const auto& k : map_.keyframes) {
     const double distance = prior_position ? (k.T_map_base.translation().head<2>() - *prior_position).norm() : 0.0;
     if (use_prior && distance > options_.prior_radius) continue;
-    const double similarity = use_words && !keyframe_histograms_.empty() ? query.dot(keyframe_histograms_.row(k.id)) : 0.0;
+    const double similarity =
+        use_words && !keyframe_histograms_.empty() ? query.dot(keyframe_histograms_.row(k.id)) : 0.0;
     ranked.push_back({use_words ? similarity : -distance, k.id});
   }
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -146,14 +150,16 @@ std::vector<int> VisualLocalizer::Retrieve(const FrameFeatures& features,
   return ids;
 }
 
-std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features, const std::vector<int>& keyframes) const {
+std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features,
+                                                   const std::vector<int>& keyframes) const {
   // The keyframes' points, by visual word: a query descriptor is compared with the points of its
   // two nearest words only (as a vocabulary tree's direct index), not with every candidate.
   std::vector<std::vector<int>> by_word(static_cast<std::size_t>(std::max(1, map_.vocabulary.rows)));
   std::set<int> seen;
   for (int id : keyframes) {
     for (int p : keyframe_points_[static_cast<std::size_t>(id)]) {
-      if (seen.insert(p).second) by_word[static_cast<std::size_t>(point_words_[static_cast<std::size_t>(p)])].push_back(p);
+      if (seen.insert(p).second)
+        by_word[static_cast<std::size_t>(point_words_[static_cast<std::size_t>(p)])].push_back(p);
     }
   }
   const int n = features.descriptors.rows;
@@ -191,8 +197,10 @@ std::vector<Correspondence> VisualLocalizer::Match(const FrameFeatures& features
   std::vector<Correspondence> correspondences;
   for (int q = 0; q < n; ++q) {
     const int p = best[static_cast<std::size_t>(q)];
-    if (p >= 0) correspondences.push_back({features.camera[static_cast<std::size_t>(q)], features.bearings[static_cast<std::size_t>(q)],
-                                           map_.points[static_cast<std::size_t>(p)]});
+    if (p >= 0)
+      correspondences.push_back({features.camera[static_cast<std::size_t>(q)],
+                                 features.bearings[static_cast<std::size_t>(q)],
+                                 map_.points[static_cast<std::size_t>(p)]});
   }
   return correspondences;
 }
@@ -217,7 +225,8 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   result.retrieved = Retrieve(features, prior_position, options_.retrieval, options_.keyframes);
   result.timings.retrieval = Since(start);
   if (features.descriptors.rows < options_.pose.min_inliers || result.retrieved.empty()) {
-    result.failure = features.descriptors.rows < options_.pose.min_inliers ? "too few features" : "no keyframe retrieved";
+    result.failure =
+        features.descriptors.rows < options_.pose.min_inliers ? "too few features" : "no keyframe retrieved";
     return result;
   }
   start = Clock::now();
@@ -236,8 +245,8 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   result.inliers = static_cast<int>(pose.inliers.size());
   // Planar covariance: position from the translation block, yaw from the rotation about z.
   Eigen::Matrix3d c;
-  c << pose.covariance(3, 3), pose.covariance(3, 4), pose.covariance(3, 2), pose.covariance(4, 3), pose.covariance(4, 4),
-      pose.covariance(4, 2), pose.covariance(2, 3), pose.covariance(2, 4), pose.covariance(2, 2);
+  c << pose.covariance(3, 3), pose.covariance(3, 4), pose.covariance(3, 2), pose.covariance(4, 3),
+      pose.covariance(4, 4), pose.covariance(4, 2), pose.covariance(2, 3), pose.covariance(2, 4), pose.covariance(2, 2);
   c(0, 0) += options_.min_position_sigma * options_.min_position_sigma;
   c(1, 1) += options_.min_position_sigma * options_.min_position_sigma;
   c(2, 2) += options_.min_yaw_sigma * options_.min_yaw_sigma;

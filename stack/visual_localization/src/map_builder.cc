@@ -10,8 +10,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
-#include <optional>
 #include <numeric>
+#include <optional>
 
 #include "trimbot/common/rotation.h"
 
@@ -46,10 +46,10 @@ class UnionFind {
 
 // Observed normalized image point vs the projection of a map point, in pixels / sigma.
 struct ReprojectionError {
-  Eigen::Vector2d observed;   // normalized (x/z, y/z) in the camera
+  Eigen::Vector2d observed;  // normalized (x/z, y/z) in the camera
   Eigen::Matrix3d R_cam_base;
   Eigen::Vector3d t_cam_base;
-  double scale;               // focal length / pixel sigma
+  double scale;  // focal length / pixel sigma
 
   template <typename T>
   bool operator()(const T* const pose, const T* const point, T* residual) const {
@@ -91,7 +91,6 @@ struct PosePrior {
     return true;
   }
 };
-
 
 // ---- matching ----------------------------------------------------------------------------------
 
@@ -162,7 +161,9 @@ std::vector<Track> JoinTracks(const std::vector<MappingKeyframe>& keyframes, con
       }
     }
   }
-  const auto index = [&](const FeatureRef& r) { return offset[r.keyframe][r.camera] + static_cast<std::size_t>(r.feature); };
+  const auto index = [&](const FeatureRef& r) {
+    return offset[r.keyframe][r.camera] + static_cast<std::size_t>(r.feature);
+  };
   UnionFind sets(refs.size());
   for (const auto& m : matches) sets.Join(index(m.a), index(m.b));
   std::map<std::size_t, Track> by_root;
@@ -202,7 +203,8 @@ std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& k
   }
   double widest = 0.0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    for (std::size_t j = i + 1; j < rays.size(); ++j) widest = std::max(widest, std::acos(std::clamp(rays[i].dot(rays[j]), -1.0, 1.0)));
+    for (std::size_t j = i + 1; j < rays.size(); ++j)
+      widest = std::max(widest, std::acos(std::clamp(rays[i].dot(rays[j]), -1.0, 1.0)));
   }
   if (widest < options.min_triangulation_angle || std::abs(A.determinant()) < 1e-12) return std::nullopt;
   const Eigen::Vector3d X = A.ldlt().solve(b);
@@ -217,7 +219,6 @@ std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& k
   return X;
 }
 
-
 // ---- adjustment --------------------------------------------------------------------------------
 
 struct PointTrack {
@@ -228,8 +229,9 @@ struct PointTrack {
 // Bundle adjustment of keyframe poses and points, the poses held near `survey` (one per keyframe);
 // returns the RMS reprojection error in pixels and each observation's error (px; points in order,
 // each point's track in order) in `errors`.
-double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, const std::vector<Eigen::Isometry3d>& survey,
-              std::vector<MappingKeyframe>& keyframes, std::vector<PointTrack>& points, std::vector<double>* errors) {
+double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options,
+              const std::vector<Eigen::Isometry3d>& survey, std::vector<MappingKeyframe>& keyframes,
+              std::vector<PointTrack>& points, std::vector<double>* errors) {
   std::vector<std::array<double, 6>> poses(keyframes.size());
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     const Eigen::AngleAxisd aa(keyframes[k].T_map_base.linear());
@@ -244,16 +246,17 @@ double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options, con
       const Eigen::Isometry3d T_cam_base = camera.T_base_camera.inverse();
       const Eigen::Vector3d& bearing = keyframes[r.keyframe].images[r.camera].bearings[r.feature];
       const double scale = camera.intrinsics.fx / options.pixel_sigma;
-      auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 6, 3>(new ReprojectionError{
-          bearing.head<2>() / bearing.z(), T_cam_base.linear(), T_cam_base.translation(), scale});
-      blocks.push_back({problem.AddResidualBlock(cost, new ceres::HuberLoss(2.0), poses[r.keyframe].data(), p.position.data()),
-                        options.pixel_sigma});
+      auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 6, 3>(
+          new ReprojectionError{bearing.head<2>() / bearing.z(), T_cam_base.linear(), T_cam_base.translation(), scale});
+      blocks.push_back(
+          {problem.AddResidualBlock(cost, new ceres::HuberLoss(2.0), poses[r.keyframe].data(), p.position.data()),
+           options.pixel_sigma});
     }
   }
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     auto* prior = new ceres::AutoDiffCostFunction<PosePrior, 6, 6>(
-        new PosePrior{survey[k].linear().transpose(), survey[k].translation(),
-                      options.survey_rotation_sigma, options.survey_position_sigma});
+        new PosePrior{survey[k].linear().transpose(), survey[k].translation(), options.survey_rotation_sigma,
+                      options.survey_position_sigma});
     problem.AddResidualBlock(prior, nullptr, poses[k].data());
   }
   ceres::Solver::Options solver;
@@ -309,7 +312,6 @@ cv::Mat TrainVocabulary(const cv::Mat& descriptors, int words) {
 }
 
 }  // namespace
-
 
 MapBuilder::MapBuilder(const robot::CameraRig& rig, const MapBuilderOptions& options) : rig_(rig), options_(options) {}
 
@@ -385,7 +387,8 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
   stats_.keyframes = static_cast<int>(map.keyframes.size());
   stats_.points = static_cast<int>(map.points.size());
   stats_.observations = static_cast<int>(map.observations.size());
-  stats_.mean_track_length = map.points.empty() ? 0.0 : static_cast<double>(map.observations.size()) / map.points.size();
+  stats_.mean_track_length =
+      map.points.empty() ? 0.0 : static_cast<double>(map.observations.size()) / map.points.size();
   if (stats != nullptr) *stats = stats_;
   return map;
 }

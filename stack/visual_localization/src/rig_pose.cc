@@ -25,7 +25,8 @@ Eigen::Vector2d Residual(const Correspondence& c, const Eigen::Isometry3d& T_bas
 }
 
 // Covariance of the pose from the inliers' residuals (Gauss-Newton information, numeric Jacobian).
-Eigen::Matrix<double, 6, 6> Covariance(const std::vector<Correspondence>& correspondences, const std::vector<int>& inliers,
+Eigen::Matrix<double, 6, 6> Covariance(const std::vector<Correspondence>& correspondences,
+                                       const std::vector<int>& inliers,
                                        const std::vector<Eigen::Isometry3d>& T_base_camera, const Eigen::Isometry3d& T,
                                        double sigma) {
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
@@ -100,7 +101,8 @@ RigPoseResult EstimateRigPose(const std::vector<Correspondence>& correspondences
     result.failure = "refinement left " + std::to_string(result.inliers.size()) + " inliers";
     return result;
   }
-  result.covariance = Covariance(correspondences, result.inliers, T_base_camera, result.T_map_base, options.angle_sigma);
+  result.covariance =
+      Covariance(correspondences, result.inliers, T_base_camera, result.T_map_base, options.angle_sigma);
   result.success = true;
   return result;
 }

@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -62,17 +62,21 @@ cv::Mat BlobRow(sqlite3_stmt* statement, int column, int width) {
 }
 
 void WriteSchema(sqlite3* db, const VisualMap& map) {
-  Exec(db, "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
-           "CREATE TABLE keyframes(id INTEGER PRIMARY KEY, stamp REAL, x REAL, y REAL, z REAL,"
-           " qw REAL, qx REAL, qy REAL, qz REAL);"
-           "CREATE TABLE points(id INTEGER PRIMARY KEY, x REAL, y REAL, z REAL, descriptor BLOB NOT NULL);"
-           "CREATE TABLE observations(keyframe INTEGER, camera INTEGER, point INTEGER, u REAL, v REAL);"
-           "CREATE TABLE vocabulary(word INTEGER PRIMARY KEY, centroid BLOB NOT NULL);");
+  Exec(db,
+       "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+       "CREATE TABLE keyframes(id INTEGER PRIMARY KEY, stamp REAL, x REAL, y REAL, z REAL,"
+       " qw REAL, qx REAL, qy REAL, qz REAL);"
+       "CREATE TABLE points(id INTEGER PRIMARY KEY, x REAL, y REAL, z REAL, descriptor BLOB NOT NULL);"
+       "CREATE TABLE observations(keyframe INTEGER, camera INTEGER, point INTEGER, u REAL, v REAL);"
+       "CREATE TABLE vocabulary(word INTEGER PRIMARY KEY, centroid BLOB NOT NULL);");
   Statement meta = Prepare(db, "INSERT INTO meta VALUES(?, ?)");
-  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-           {"format", "trimbot visual map"}, {"version", std::to_string(kMapFormatVersion)},
-           {"garden", map.garden}, {"rig_signature", map.rig_signature}, {"descriptor", ToString(map.descriptor)},
-           {"descriptor_size", std::to_string(map.descriptors.cols)}}) {
+  for (const auto& [key, value] :
+       std::vector<std::pair<std::string, std::string>>{{"format", "trimbot visual map"},
+                                                        {"version", std::to_string(kMapFormatVersion)},
+                                                        {"garden", map.garden},
+                                                        {"rig_signature", map.rig_signature},
+                                                        {"descriptor", ToString(map.descriptor)},
+                                                        {"descriptor_size", std::to_string(map.descriptors.cols)}}) {
     sqlite3_bind_text(meta.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(meta.get(), 2, value.c_str(), -1, SQLITE_TRANSIENT);
     Step(db, meta.get());
@@ -135,7 +139,8 @@ void ReadRows(sqlite3* db, int descriptor_size, VisualMap* map) {
   Statement points = Prepare(db, "SELECT id, x, y, z, descriptor FROM points ORDER BY id");
   std::vector<cv::Mat> rows;
   while (sqlite3_step(points.get()) == SQLITE_ROW) {
-    if (sqlite3_column_int(points.get(), 0) != static_cast<int>(map->points.size())) throw SqlError("point ids have gaps");
+    if (sqlite3_column_int(points.get(), 0) != static_cast<int>(map->points.size()))
+      throw SqlError("point ids have gaps");
     map->points.emplace_back(sqlite3_column_double(points.get(), 1), sqlite3_column_double(points.get(), 2),
                              sqlite3_column_double(points.get(), 3));
     rows.push_back(BlobRow(points.get(), 4, descriptor_size));
@@ -183,8 +188,7 @@ void VisualMap::Save(const std::string& path) const {
 }
 
 VisualMap VisualMap::Load(const std::string& path, const std::string& expected_garden,
-                          const std::string& expected_rig_signature,
-                          std::optional<Descriptor> expected_descriptor) {
+                          const std::string& expected_rig_signature, std::optional<Descriptor> expected_descriptor) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path, "map file not found");
   sqlite3* raw = nullptr;
   if (sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
@@ -212,7 +216,8 @@ VisualMap VisualMap::Load(const std::string& path, const std::string& expected_g
     throw InputError(path, std::string("not a valid map file (") + e.what() + ")");
   }
   if (!expected_garden.empty() && map.garden != expected_garden) {
-    throw InputError(path, "the map was made in garden '" + map.garden + "', the robot is in '" + expected_garden + "'");
+    throw InputError(path,
+                     "the map was made in garden '" + map.garden + "', the robot is in '" + expected_garden + "'");
   }
   if (!expected_rig_signature.empty() && map.rig_signature != expected_rig_signature) {
     throw InputError(path, "the map was made with another camera rig (signature " + map.rig_signature + ", this rig " +

@@ -23,10 +23,9 @@ class InputError : public std::runtime_error {
 // A name that can become a file name inside an output folder: letters, digits, '_', '-', '.', not
 // starting with '.' (so never "..", a path or a hidden file), 1 to 100 characters.
 inline bool IsPlainName(const std::string& name) {
-  return !name.empty() && name.size() <= 100 && name[0] != '.' &&
-         std::all_of(name.begin(), name.end(), [](char c) {
-           return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
-         });
+  return !name.empty() && name.size() <= 100 && name[0] != '.' && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  });
 }
 
 }  // namespace trimbot

@@ -11,9 +11,9 @@
 namespace trimbot {
 
 struct Override {
-  std::string key;    // dotted path, e.g. stack.navigation.follower.cruise_speed
+  std::string key;  // dotted path, e.g. stack.navigation.follower.cruise_speed
   YAML::Node value;
-  std::string text;   // as given, for records
+  std::string text;  // as given, for records
 };
 
 // Parses "key.path=value". Throws InputError naming `--set` when it is not of that form.

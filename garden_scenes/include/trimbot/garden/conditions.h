@@ -12,7 +12,7 @@ struct Conditions {
   double time_of_day = 14.0;  // h, local solar time
   int day_of_year = 250;      // early September, when the real evaluation ran
   bool shadows = true;
-  double growth = 0.0;        // 0: freshly trimmed .. 1: a season's growth (up to ~15 cm, irregular)
+  double growth = 0.0;  // 0: freshly trimmed .. 1: a season's growth (up to ~15 cm, irregular)
 
   // Reads a `conditions:` map (all keys optional); unknown keys are errors.
   static Conditions FromYaml(const YamlMap& map);

@@ -18,13 +18,13 @@ namespace trimbot::garden {
 enum class Shape { kBox, kCylinder, kEllipsoid };
 
 struct GardenObject {
-  int id = 0;                                       // unique in the garden, 1..kMaxGardenObjectId
+  int id = 0;  // unique in the garden, 1..kMaxGardenObjectId
   ObjectClass object_class = ObjectClass::kObstacle;
-  Shape shape = Shape::kBox;                        // the trimmed / nominal shape
-  Eigen::Vector3d size = Eigen::Vector3d::Ones();   // m, full extent along x, y, z before yaw
+  Shape shape = Shape::kBox;                           // the trimmed / nominal shape
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();      // m, full extent along x, y, z before yaw
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // m, centre of the footprint in the map frame
-  double base_height = 0.0;                         // m above the ground where the object starts
-  double yaw = 0.0;                                 // rad about z
+  double base_height = 0.0;                            // m above the ground where the object starts
+  double yaw = 0.0;                                    // rad about z
 };
 
 // A rectangle of another ground surface (a path or a bed), flush with the lawn.
@@ -41,12 +41,12 @@ constexpr double kMaxGardenExtent = 200.0;
 
 struct Garden {
   std::string name;
-  std::string source;                       // file it was read from
-  Eigen::Vector2d size = Eigen::Vector2d(10, 10);     // m, ground extent
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();   // m, ground centre in the map frame
+  std::string source;                                // file it was read from
+  Eigen::Vector2d size = Eigen::Vector2d(10, 10);    // m, ground extent
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // m, ground centre in the map frame
   Surface ground = Surface::kGrass;
-  double latitude = 52.0 * M_PI / 180.0;    // rad (Wageningen by default), for the sun's path
-  double north = M_PI / 2;                  // rad, direction of north in the map frame (from +x, CCW)
+  double latitude = 52.0 * M_PI / 180.0;  // rad (Wageningen by default), for the sun's path
+  double north = M_PI / 2;                // rad, direction of north in the map frame (from +x, CCW)
   // Seeds the garden's look - textures, leaf clumps, outgrowth - so every run in this garden sees
   // the same garden (a run's own seed drives only sensor noise, faults and dynamics). The file's
   // `seed:`, or else one derived from the garden's name.

@@ -26,17 +26,17 @@ struct GeneratorParameters {
   int trees = 2;
   int obstacles = 2;
   int paths = 2;
-  bool fence = true;              // a low fence around the garden
-  double robot_clearance = 0.9;   // m of free space kept between objects so the robot can pass
+  bool fence = true;             // a low fence around the garden
+  double robot_clearance = 0.9;  // m of free space kept between objects so the robot can pass
 };
 // A new garden from the parameters; the same seed gives the same garden. Objects do not overlap
 // each other or the paths and keep robot_clearance between them.
 Garden GenerateGarden(const GeneratorParameters& parameters);
 
 struct OccupancyMap {
-  cv::Mat occupied;           // CV_8U, 255 = occupied, row 0 = the map's top (largest y)
-  double resolution = 0.05;   // m per cell
-  Eigen::Vector2d origin;     // map coordinates of the bottom-left corner of the bottom-left cell
+  cv::Mat occupied;          // CV_8U, 255 = occupied, row 0 = the map's top (largest y)
+  double resolution = 0.05;  // m per cell
+  Eigen::Vector2d origin;    // map coordinates of the bottom-left corner of the bottom-left cell
   // Cell (column, row) holding a map point.
   cv::Point Cell(const Eigen::Vector2d& point) const;
 };
@@ -48,7 +48,6 @@ void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const st
 
 // Samples the garden's surfaces (ground, paths, object meshes as grown under `growth`, shaped by the
 // garden's appearance seed) into an ASCII PLY point cloud with per-point class and object id.
-void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2,
-                         const std::string& path);
+void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2, const std::string& path);
 
 }  // namespace trimbot::garden

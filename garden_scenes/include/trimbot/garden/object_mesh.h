@@ -14,7 +14,7 @@
 namespace trimbot::garden {
 
 struct Mesh {
-  std::vector<Eigen::Vector3d> vertices;  // m, in the object frame (origin at the footprint centre, z up)
+  std::vector<Eigen::Vector3d> vertices;   // m, in the object frame (origin at the footprint centre, z up)
   std::vector<Eigen::Vector2d> texcoords;  // per vertex, in texture tiles
   std::vector<std::array<int, 3>> faces;   // counter-clockwise seen from outside
 

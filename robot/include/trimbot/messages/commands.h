@@ -44,7 +44,8 @@ inline RingRequest Merge(const RingRequest& a, const RingRequest& b) {
   if (a.empty()) return b;
   if (b.empty()) return a;
   RingRequest out;
-  std::set_union(a.cameras.begin(), a.cameras.end(), b.cameras.begin(), b.cameras.end(), std::back_inserter(out.cameras));
+  std::set_union(a.cameras.begin(), a.cameras.end(), b.cameras.begin(), b.cameras.end(),
+                 std::back_inserter(out.cameras));
   out.resolution_scale = std::max(a.resolution_scale, b.resolution_scale);
   return out;
 }

@@ -11,8 +11,8 @@ namespace trimbot::messages {
 
 // One camera image, row-major, top row first.
 struct Image {
-  double stamp = 0.0;        // s, mid-exposure
-  int camera_index = -1;     // index into the camera rig calibration (cam0..cam9)
+  double stamp = 0.0;     // s, mid-exposure
+  int camera_index = -1;  // index into the camera rig calibration (cam0..cam9)
   int width = 0;
   int height = 0;
   std::string encoding = "rgb8";  // "rgb8" (3 bytes per pixel) or "mono8"
@@ -48,12 +48,12 @@ struct ArmJointState {
 };
 
 // An absolute pose of base_link in the map frame from a localization source outside the stack's
-// own components (e.g. a separate localization process, or the test fixture that simulates one). `stamp` is when the pose was true (the capture time of the images it
-// came from); it arrives later, after the source's processing time.
+// own components (e.g. a separate localization process, or the test fixture that simulates one). `stamp` is when the
+// pose was true (the capture time of the images it came from); it arrives later, after the source's processing time.
 struct PoseFix {
   double stamp = 0.0;
-  double x = 0.0, y = 0.0, yaw = 0.0;                          // m, m, rad (map frame)
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();    // of (x, y, yaw)
+  double x = 0.0, y = 0.0, yaw = 0.0;                        // m, m, rad (map frame)
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // of (x, y, yaw)
 };
 
 }  // namespace trimbot::messages

@@ -35,7 +35,7 @@ struct CameraCalibration {
 };
 
 struct StereoPair {
-  int left = -1;   // camera indices
+  int left = -1;  // camera indices
   int right = -1;
   double baseline = 0.0;  // m
 };

@@ -61,9 +61,9 @@ class CollisionEnvironment {
 };
 
 struct CollisionCheckOptions {
-  bool self = true;            // robot against itself
-  bool environment = true;     // the varied links against the environment
-  bool distance = false;       // also the clearance (slower): min distance over the pairs checked
+  bool self = true;         // robot against itself
+  bool environment = true;  // the varied links against the environment
+  bool distance = false;    // also the clearance (slower): min distance over the pairs checked
   // Links whose pose does not change with the varied joints are checked against the environment too
   // (off for arm planning, where the base stands where it is).
   bool static_links_against_environment = false;

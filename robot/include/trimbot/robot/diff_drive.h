@@ -4,7 +4,7 @@
 namespace trimbot::robot {
 
 struct WheelSpeeds {
-  double left = 0.0;   // rad/s, positive drives forward
+  double left = 0.0;  // rad/s, positive drives forward
   double right = 0.0;
 };
 
@@ -17,9 +17,7 @@ struct DiffDriveGeometry {
             (linear + 0.5 * wheel_separation * angular) / wheel_radius};
   }
   double LinearFromWheels(const WheelSpeeds& w) const { return 0.5 * wheel_radius * (w.left + w.right); }
-  double AngularFromWheels(const WheelSpeeds& w) const {
-    return wheel_radius * (w.right - w.left) / wheel_separation;
-  }
+  double AngularFromWheels(const WheelSpeeds& w) const { return wheel_radius * (w.right - w.left) / wheel_separation; }
 };
 
 }  // namespace trimbot::robot

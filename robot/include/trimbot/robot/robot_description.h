@@ -37,8 +37,7 @@ class RobotDescription {
   const std::string& path() const { return path_; }
 
   // Pose of a link in base_link with every joint at the given position (default zero).
-  Eigen::Isometry3d FramePose(const std::string& link,
-                              const std::map<std::string, double>& joint_positions = {}) const;
+  Eigen::Isometry3d FramePose(const std::string& link, const std::map<std::string, double>& joint_positions = {}) const;
   // Pose of a child link in its parent link for the joint at position q.
   static Eigen::Isometry3d JointTransform(const urdf::Joint& joint, double q);
 

@@ -28,8 +28,8 @@ struct WheelEncoderConfig {
 // `max_gain`, which amplifies the read noise too).
 struct AutoExposure {
   bool enabled = true;
-  double target_mean = 100.0;       // grey levels
-  double metering_top = 0.4;        // 0..1
+  double target_mean = 100.0;  // grey levels
+  double metering_top = 0.4;   // 0..1
   double max_exposure_factor = 4.0;
   double max_gain = 4.0;
 };

@@ -20,13 +20,13 @@ namespace trimbot::sim {
 
 // Wall-clock seconds spent per rendering stage since the renderer was made.
 struct RenderTimings {
-  double draw = 0.0;        // OpenGL drawing (scene update, shadow map, rasterization)
-  double readback = 0.0;    // the MSAA resolve, reading the pixels back, flipping them upright
-  double distortion = 0.0;  // resampling the pinhole render into the calibrated (distorted) camera
+  double draw = 0.0;          // OpenGL drawing (scene update, shadow map, rasterization)
+  double readback = 0.0;      // the MSAA resolve, reading the pixels back, flipping them upright
+  double distortion = 0.0;    // resampling the pinhole render into the calibrated (distorted) camera
   double ground_truth = 0.0;  // depth to metres, the label pass and their remaps, when asked for
-  long images = 0;          // camera images rendered
-  long geoms_in_view = 0;   // summed over colour images: geoms drawn,
-  long geoms_culled = 0;    // and geoms outside the view volume (and their shadows), not drawn
+  long images = 0;            // camera images rendered
+  long geoms_in_view = 0;     // summed over colour images: geoms drawn,
+  long geoms_culled = 0;      // and geoms outside the view volume (and their shadows), not drawn
 };
 
 class RingRenderer {

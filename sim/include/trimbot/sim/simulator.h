@@ -33,25 +33,25 @@ namespace trimbot::sim {
 class World;
 
 struct SimulatorConfig {
-  robot::RobotFiles robot;           // urdf, camchain (the cameras as they really are), parameters
+  robot::RobotFiles robot;  // urdf, camchain (the cameras as they really are), parameters
   std::string garden_path;
   // Objects placed in the world beyond the garden file's (a scenario's obstacles the survey never
   // saw); their ids must not be the garden's.
   std::vector<garden::GardenObject> extra_objects;
-  std::string world_dir;             // where world.xml and its textures are written
+  std::string world_dir;  // where world.xml and its textures are written
   std::uint64_t seed = 0;
-  garden::Conditions conditions;     // time of day, shadows, growth
+  garden::Conditions conditions;  // time of day, shadows, growth
   Pose2D start;
-  double timestep = 0.0025;          // s
+  double timestep = 0.0025;  // s
   bool render_cameras = true;
-  bool cameras_on_schedule = true;   // false: the ring renders only when CaptureRing is called
+  bool cameras_on_schedule = true;    // false: the ring renders only when CaptureRing is called
   int ground_truth_every_frames = 0;  // depth and label images with every n-th ring frame (0: none)
-  double resolution_scale = 1.0;     // 0.5 renders half-resolution images
-  int msaa_samples = 4;              // anti-aliasing; 0 halves the render time, edges get jagged
-  bool frustum_culling = true;       // each camera draws only the geoms that can show in it (same image)
-  double imu_noise_scale = 1.0;      // multiplies every IMU noise parameter
-  double wheel_slip_scale = 1.0;     // multiplies the surfaces' slip (mean and spread)
-  std::vector<Fault> faults;         // injected at their times
+  double resolution_scale = 1.0;      // 0.5 renders half-resolution images
+  int msaa_samples = 4;               // anti-aliasing; 0 halves the render time, edges get jagged
+  bool frustum_culling = true;        // each camera draws only the geoms that can show in it (same image)
+  double imu_noise_scale = 1.0;       // multiplies every IMU noise parameter
+  double wheel_slip_scale = 1.0;      // multiplies the surfaces' slip (mean and spread)
+  std::vector<Fault> faults;          // injected at their times
 };
 
 // What the robot's drivers deliver in one physics step.
@@ -59,7 +59,7 @@ struct SensorOutputs {
   std::vector<messages::ImuSample> imu;
   std::vector<messages::WheelTicks> wheel_ticks;
   std::vector<messages::ArmJointState> arm_joints;
-  std::optional<messages::RingFrame> ring;   // noisy images, when the ring was rendered this step
+  std::optional<messages::RingFrame> ring;  // noisy images, when the ring was rendered this step
   void Clear() {
     imu.clear();
     wheel_ticks.clear();
@@ -110,29 +110,29 @@ struct GroundTruth {
   // The ring's cameras were triggered in this step and deliver images (no dropout), whether or
   // not they were rendered: what an image-driven source (or its simulated stand-in) works from.
   bool ring_exposed = false;
-  std::optional<RingTruth> ring;                // with SensorOutputs::ring
-  std::vector<ObstacleContact> contacts;        // robot against garden objects, now
-  std::vector<ArmContact> arm_contacts;         // the arm against anything, now
+  std::optional<RingTruth> ring;          // with SensorOutputs::ring
+  std::vector<ObstacleContact> contacts;  // robot against garden objects, now
+  std::vector<ArmContact> arm_contacts;   // the arm against anything, now
 };
 
 // Wall-clock seconds the simulator spent per stage since it was made (not part of any result:
 // for the run's timing report).
 struct SimulatorTimings {
-  double physics = 0.0;         // actuation, MuJoCo step, IMU / encoder models, contacts
-  double render_draw = 0.0;     // OpenGL drawing of the camera images
-  double render_readback = 0.0; // pixels back from OpenGL
-  double distortion = 0.0;      // pinhole render -> calibrated radtan camera (precomputed remap)
-  double exposure_noise = 0.0;  // auto exposure and read noise
-  double ground_truth = 0.0;    // depth and label images, when asked for
+  double physics = 0.0;          // actuation, MuJoCo step, IMU / encoder models, contacts
+  double render_draw = 0.0;      // OpenGL drawing of the camera images
+  double render_readback = 0.0;  // pixels back from OpenGL
+  double distortion = 0.0;       // pinhole render -> calibrated radtan camera (precomputed remap)
+  double exposure_noise = 0.0;   // auto exposure and read noise
+  double ground_truth = 0.0;     // depth and label images, when asked for
   long physics_steps = 0;
   long ring_frames = 0;
   long camera_images = 0;
-  long geoms_drawn = 0;         // summed over camera images: geoms in each camera's view volume
-  long geoms_culled = 0;        // and those outside it, not drawn
+  long geoms_drawn = 0;   // summed over camera images: geoms in each camera's view volume
+  long geoms_culled = 0;  // and those outside it, not drawn
 };
 
 struct RingCapture {
-  messages::RingFrame frame;   // sensor output (noisy images)
+  messages::RingFrame frame;  // sensor output (noisy images)
   RingTruth truth;
 };
 

@@ -24,7 +24,7 @@ struct WorldOptions {
   garden::Conditions conditions;  // sun and growth
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;
-  int msaa_samples = 4;           // multisample anti-aliasing; 0 renders twice as fast, with jagged edges
+  int msaa_samples = 4;  // multisample anti-aliasing; 0 renders twice as fast, with jagged edges
   // Generated textures are kept here by (material, garden seed, size, generator version) and
   // copied into each world: every trial of a batch, and every test, uses the same few (seconds
   // to generate and encode). Empty: always generate.
@@ -32,13 +32,12 @@ struct WorldOptions {
 };
 
 struct WorldSpec {
-  std::string mjcf_path;           // world.xml written to disk (robot.xml beside it)
-  std::vector<GeomLabel> labels;   // every named geom that can appear in a label image
+  std::string mjcf_path;                  // world.xml written to disk (robot.xml beside it)
+  std::vector<GeomLabel> labels;          // every named geom that can appear in a label image
   std::vector<std::string> camera_names;  // MuJoCo camera i renders rig camera i
 };
 
-WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig,
-                       const garden::Garden& garden, const WorldOptions& options,
-                       const std::string& output_dir);
+WorldSpec ComposeWorld(const robot::RobotDescription& robot, const robot::CameraRig& rig, const garden::Garden& garden,
+                       const WorldOptions& options, const std::string& output_dir);
 
 }  // namespace trimbot::sim

@@ -26,32 +26,32 @@ namespace trimbot::arm {
 
 struct ArmExecutiveParameters {
   ArmPlannerParameters planner;
-  double cell = 0.02;              // m: octree cell of the perceived points
-  double margin = 0.02;            // m: cells are grown by this (stereo noise)
-  int min_points_per_cell = 2;     // fewer: a stray match, not a surface
-  double max_point_sigma = 0.05;   // m: points less certain than this along their worst axis are dropped
-  double reach = 1.3;              // m from the arm's base: farther points cannot be hit
-  double ground_clearance = 0.02;  // m: the ground plane the arm must stay above; points below 2x it are ground
-  double body_margin = 0.05;       // m: points within the base's outline grown by this are the robot itself
-  double settle_tolerance = 0.002; // rad: every joint within this of the trajectory's end
-  double settle_timeout = 3.0;     // s after the trajectory's end
+  double cell = 0.02;               // m: octree cell of the perceived points
+  double margin = 0.02;             // m: cells are grown by this (stereo noise)
+  int min_points_per_cell = 2;      // fewer: a stray match, not a surface
+  double max_point_sigma = 0.05;    // m: points less certain than this along their worst axis are dropped
+  double reach = 1.3;               // m from the arm's base: farther points cannot be hit
+  double ground_clearance = 0.02;   // m: the ground plane the arm must stay above; points below 2x it are ground
+  double body_margin = 0.05;        // m: points within the base's outline grown by this are the robot itself
+  double settle_tolerance = 0.002;  // rad: every joint within this of the trajectory's end
+  double settle_timeout = 3.0;      // s after the trajectory's end
 };
 
 // How one goal went, as the stack knows it (encoders and its own kinematics).
 struct ArmGoalResult {
   int goal = 0;
   bool reached = false;
-  std::string failure;             // when not reached
-  double start = 0.0, end = 0.0;   // s: planning began, result known
+  std::string failure;            // when not reached
+  double start = 0.0, end = 0.0;  // s: planning began, result known
   int ik_solutions = 0, free_goals = 0;
   long validity_checks = 0;
-  double planning_seconds = 0.0;   // wall clock
-  double path_length = 0.0;        // rad, joint space
-  double cutter_path_length = 0.0; // m
-  double motion_duration = 0.0;    // s: the trajectory's
-  double tracking_error_max = 0.0; // rad: measured joints against the trajectory, over the motion
-  double position_error = 0.0;     // m: the cutter (by the encoders) from the goal at the end
-  double orientation_error = 0.0;  // rad
+  double planning_seconds = 0.0;    // wall clock
+  double path_length = 0.0;         // rad, joint space
+  double cutter_path_length = 0.0;  // m
+  double motion_duration = 0.0;     // s: the trajectory's
+  double tracking_error_max = 0.0;  // rad: measured joints against the trajectory, over the motion
+  double position_error = 0.0;      // m: the cutter (by the encoders) from the goal at the end
+  double orientation_error = 0.0;   // rad
 };
 
 class ArmExecutive {
@@ -114,7 +114,8 @@ const char* ToString(ArmExecutive::Mode mode);
 // within reach of the arm's base, outside the base's outline and above the ground, grown by
 // `margin`. Replaces what `environment` held; returns the number of occupied cells.
 int BuildPerceivedEnvironment(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters,
-                              const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances,
+                              const std::vector<Eigen::Vector3d>& points,
+                              const std::vector<Eigen::Matrix3d>& covariances,
                               robot::CollisionEnvironment* environment);
 
 }  // namespace trimbot::arm

@@ -20,26 +20,26 @@ namespace trimbot::arm {
 
 struct JointLimit {
   std::string name;
-  bool continuous = false;   // no position limits (the Jaco's joints 1, 4, 5, 6)
+  bool continuous = false;          // no position limits (the Jaco's joints 1, 4, 5, 6)
   double lower = 0.0, upper = 0.0;  // rad, when not continuous
-  double velocity = 0.0;     // rad/s
+  double velocity = 0.0;            // rad/s
 };
 
 struct IkOptions {
   // LM runs from the database's configurations whose poses are nearest the target (pre-computed
   // solutions, as on the real robot), then from fixed starts spread evenly over joint space.
-  int database_seeds = 96;         // with 8 starts: every branch that 1024 starts find, on 200 random poses
-  int database_size = 1 << 16;     // configurations in the database (built once, on first use)
-  int starts = 8;                  // same pose, same answer
-  double position_tolerance = 1e-6;   // m
+  int database_seeds = 96;              // with 8 starts: every branch that 1024 starts find, on 200 random poses
+  int database_size = 1 << 16;          // configurations in the database (built once, on first use)
+  int starts = 8;                       // same pose, same answer
+  double position_tolerance = 1e-6;     // m
   double orientation_tolerance = 1e-6;  // rad
-  int max_iterations = 300;        // per start: bounded, so an unreachable pose fails, never hangs
-  double distinct = 1e-3;          // rad: solutions closer than this in every joint are one
+  int max_iterations = 300;             // per start: bounded, so an unreachable pose fails, never hangs
+  double distinct = 1e-3;               // rad: solutions closer than this in every joint are one
 };
 
 struct IkResult {
   std::vector<Eigen::VectorXd> solutions;  // distinct, within the limits, ordered by the first start that found them
-  std::string failure;  // when none: why (unreachable by how much, or only outside the limits)
+  std::string failure;                     // when none: why (unreachable by how much, or only outside the limits)
 };
 
 struct SeedDatabase;

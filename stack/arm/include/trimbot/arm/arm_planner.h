@@ -27,11 +27,11 @@ namespace trimbot::arm {
 struct ArmPlannerParameters {
   enum class Algorithm { kRrtConnect, kLazyPrm };
   Algorithm algorithm = Algorithm::kRrtConnect;
-  int max_iterations = 20000;          // planner iterations per query (a budget that is the same on every machine)
-  double collision_step = 0.02;        // rad: motions are checked at this joint-space spacing
-  double velocity_scale = 0.5;         // fraction of the URDF's joint velocity limits
-  double acceleration = 1.5;           // rad/s^2 per joint
-  double cartesian_step = 0.005;       // m of cutter travel between inverse-kinematics steps of a pass
+  int max_iterations = 20000;             // planner iterations per query (a budget that is the same on every machine)
+  double collision_step = 0.02;           // rad: motions are checked at this joint-space spacing
+  double velocity_scale = 0.5;            // fraction of the URDF's joint velocity limits
+  double acceleration = 1.5;              // rad/s^2 per joint
+  double cartesian_step = 0.005;          // m of cutter travel between inverse-kinematics steps of a pass
   double cartesian_max_joint_step = 0.1;  // rad per step: more means the arm would switch branch
   IkOptions ik;
 };
@@ -48,15 +48,15 @@ struct JointTrajectory {
 
 struct ArmPlan {
   bool ok = false;
-  std::string failure;                    // when not ok: why (unreachable, every solution collides, no path)
-  std::vector<Eigen::VectorXd> waypoints; // the simplified path, unwrapped from the start
+  std::string failure;                     // when not ok: why (unreachable, every solution collides, no path)
+  std::vector<Eigen::VectorXd> waypoints;  // the simplified path, unwrapped from the start
   JointTrajectory trajectory;
-  int ik_solutions = 0;                   // of the goal pose
-  int free_goals = 0;                     // of which collision-free
-  double path_length = 0.0;               // rad: joint-space length of the waypoints
-  double cutter_path_length = 0.0;        // m: the cutter's travel along the trajectory
+  int ik_solutions = 0;             // of the goal pose
+  int free_goals = 0;               // of which collision-free
+  double path_length = 0.0;         // rad: joint-space length of the waypoints
+  double cutter_path_length = 0.0;  // m: the cutter's travel along the trajectory
   long validity_checks = 0;
-  double planning_seconds = 0.0;          // wall clock (for reports and benchmarks only)
+  double planning_seconds = 0.0;  // wall clock (for reports and benchmarks only)
 };
 
 class ArmPlanner {

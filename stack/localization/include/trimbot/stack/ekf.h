@@ -29,15 +29,15 @@ struct EkfParameters {
   double angular_acceleration_density = 1.0;  // rad/s^2/sqrt(Hz)
   double gyro_bias_random_walk = 2.0e-4;      // rad/s^2/sqrt(Hz) (tuned above the sensor's value)
   // Measurement noise.
-  double wheel_speed_sigma = 0.02;            // m/s per wheel-derived body speed, plus:
-  double wheel_slip_fraction = 0.05;          // sigma grows with speed (grass slips a few percent)
-  double gyro_sigma = 0.005;                  // rad/s, one gyro sample
+  double wheel_speed_sigma = 0.02;    // m/s per wheel-derived body speed, plus:
+  double wheel_slip_fraction = 0.05;  // sigma grows with speed (grass slips a few percent)
+  double gyro_sigma = 0.005;          // rad/s, one gyro sample
   // Pose fixes.
-  double fix_gate_chi2 = 11.34;               // 3 dof, 99 %: beyond this a fix is an outlier
-  int relocalize_after_rejections = 5;        // consistent rejected fixes in a row -> accept
-  double relocalize_consistency = 0.5;        // m: rejected fixes agree if within this of each other
-  double history_seconds = 3.0;               // how far back a late fix can be applied
-  double max_fix_lead = 0.5;                  // s: fixes stamped further ahead of the filter are invalid
+  double fix_gate_chi2 = 11.34;         // 3 dof, 99 %: beyond this a fix is an outlier
+  int relocalize_after_rejections = 5;  // consistent rejected fixes in a row -> accept
+  double relocalize_consistency = 0.5;  // m: rejected fixes agree if within this of each other
+  double history_seconds = 3.0;         // how far back a late fix can be applied
+  double max_fix_lead = 0.5;            // s: fixes stamped further ahead of the filter are invalid
 };
 
 // Filter output at its current time.
@@ -53,10 +53,10 @@ enum class FixOutcome { kAccepted, kRejectedOutlier, kRelocalized, kTooOld, kInv
 
 struct EkfCounters {
   int fixes_accepted = 0;
-  int fixes_rejected = 0;     // outliers
-  int relocalizations = 0;    // rejected runs accepted as a re-localization
-  int fixes_too_old = 0;      // older than the history buffer
-  int inputs_dropped = 0;     // invalid inputs of any kind
+  int fixes_rejected = 0;   // outliers
+  int relocalizations = 0;  // rejected runs accepted as a re-localization
+  int fixes_too_old = 0;    // older than the history buffer
+  int inputs_dropped = 0;   // invalid inputs of any kind
 };
 
 class Ekf {

@@ -76,7 +76,7 @@ class GyroOdometry {
   const Pose2& pose() const { return pose_; }
 
  private:
-  WheelOdometry wheels_;        // its distance per reading; its heading is not used
+  WheelOdometry wheels_;  // its distance per reading; its heading is not used
   double last_gyro_stamp_ = -1.0;
   double heading_at_ticks_ = 0.0;  // at the previous wheel reading
   Pose2 pose_;

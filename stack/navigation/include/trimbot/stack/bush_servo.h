@@ -18,28 +18,28 @@
 namespace trimbot::stack {
 
 struct BushServoParameters {
-  double surface_gap = 0.7;          // m: from the bush's surveyed outline to the arm's axis (the
-                                     // standoff is the bush's radius plus this); stereo sees from
-                                     // 0.5 m, the footprint's front keeps ~0.2 m from the foliage
-  double bearing = 0.0;              // rad: where the bush should stand, seen from the arm's axis
-  double distance_tolerance = 0.005; // m: arrived when both are within these
+  double surface_gap = 0.7;                       // m: from the bush's surveyed outline to the arm's axis (the
+                                                  // standoff is the bush's radius plus this); stereo sees from
+                                                  // 0.5 m, the footprint's front keeps ~0.2 m from the foliage
+  double bearing = 0.0;                           // rad: where the bush should stand, seen from the arm's axis
+  double distance_tolerance = 0.005;              // m: arrived when both are within these
   double bearing_tolerance = 0.5 * M_PI / 180.0;  // rad
   double turn_first = 3.0 * M_PI / 180.0;         // rad: a bearing error above this is turned away on the spot
-  double gain = 1.0;                 // 1/s: speed per metre of distance error
-  double turn_gain = 1.5;            // 1/s: turn rate per radian of bearing error
-  double max_speed = 0.08;           // m/s
-  double min_speed = 0.015;          // m/s: slower than this the base hardly moves
-  double max_turn_rate = 0.3;        // rad/s
-  double min_turn_rate = 0.03;       // rad/s
-  double range_sigma = 0.01;         // m: a frame's centre is good to range_sigma * (range / 1 m)^2
-  double memory = 0.7;               // per frame, the weight kept of what was tracked before: old
-                                     // frames carry the odometry's heading drift since they were taken
-  double max_jump = 0.15;            // m: a frame's centre this far from the track is not the bush
-  double first_gate_margin = 0.25;   // m: added for the first frame, gated by the map's belief
-  int settle_frames = 2;             // frames taken standing still that must confirm arrival
-  double settle_time = 0.3;          // s after stopping before a frame counts as standing still
-  int max_lost_frames = 8;           // frames in a row without a usable centre -> give up
-  double timeout = 90.0;             // s for the whole servo
+  double gain = 1.0;                              // 1/s: speed per metre of distance error
+  double turn_gain = 1.5;                         // 1/s: turn rate per radian of bearing error
+  double max_speed = 0.08;                        // m/s
+  double min_speed = 0.015;                       // m/s: slower than this the base hardly moves
+  double max_turn_rate = 0.3;                     // rad/s
+  double min_turn_rate = 0.03;                    // rad/s
+  double range_sigma = 0.01;                      // m: a frame's centre is good to range_sigma * (range / 1 m)^2
+  double memory = 0.7;                            // per frame, the weight kept of what was tracked before: old
+                                                  // frames carry the odometry's heading drift since they were taken
+  double max_jump = 0.15;                         // m: a frame's centre this far from the track is not the bush
+  double first_gate_margin = 0.25;                // m: added for the first frame, gated by the map's belief
+  int settle_frames = 2;                          // frames taken standing still that must confirm arrival
+  double settle_time = 0.3;                       // s after stopping before a frame counts as standing still
+  int max_lost_frames = 8;                        // frames in a row without a usable centre -> give up
+  double timeout = 90.0;                          // s for the whole servo
 };
 
 class BushServo {
@@ -82,7 +82,7 @@ class BushServo {
   double weight_ = 0.0;
   double target_distance_ = 0.0;
   double start_ = 0.0;
-  double stopped_since_ = -1.0;   // s: when the base was last commanded to stand (settling)
+  double stopped_since_ = -1.0;  // s: when the base was last commanded to stand (settling)
   int settle_count_ = 0;
   int lost_ = 0;
   std::optional<Eigen::Vector2d> candidate_;  // the last centre the track refused (odometry frame)

@@ -27,13 +27,13 @@ struct Footprint {
 
 struct PlannerParameters {
   Footprint footprint;
-  double robot_radius = 0.5;          // m: clearance from base_link to the map's obstacles
-  double footprint_margin = 0.1;      // m: clearance of the footprint driving along the path
-  double start_footprint_free = 0.25; // m: near the start only base_link's clearance is checked (the
-                                      // robot turns on the spot there; the obstacle stop guards it)
-  int iterations = 3000;              // RRT* iterations per plan
-  double range = 1.5;                 // m: longest RRT* edge
-  double start_escape_radius = 1.0;   // m: a start inside the clearance is moved out by up to this
+  double robot_radius = 0.5;           // m: clearance from base_link to the map's obstacles
+  double footprint_margin = 0.1;       // m: clearance of the footprint driving along the path
+  double start_footprint_free = 0.25;  // m: near the start only base_link's clearance is checked (the
+                                       // robot turns on the spot there; the obstacle stop guards it)
+  int iterations = 3000;               // RRT* iterations per plan
+  double range = 1.5;                  // m: longest RRT* edge
+  double start_escape_radius = 1.0;    // m: a start inside the clearance is moved out by up to this
 };
 
 struct PlanResult {

@@ -21,28 +21,33 @@
 namespace trimbot::stack {
 
 struct NavigatorParameters {
-  PlannerParameters planner;         // holds the footprint
+  PlannerParameters planner;  // holds the footprint
   FollowerParameters follower;
-  double stop_clearance = 0.03;      // m: footprint this close to the map's obstacles -> stop
-  double turn_check_angle = 0.3;     // rad: a turn on the spot is checked this far ahead
-  double resume_clearance = 0.2;     // m: back off until this much is free again
-  double backoff_speed = 0.1;        // m/s
-  double max_backoff = 0.6;          // m
-  double replan_deviation = 0.6;     // m off the path -> plan again
+  double stop_clearance = 0.03;   // m: footprint this close to the map's obstacles -> stop
+  double turn_check_angle = 0.3;  // rad: a turn on the spot is checked this far ahead
+  double resume_clearance = 0.2;  // m: back off until this much is free again
+  double backoff_speed = 0.1;     // m/s
+  double max_backoff = 0.6;       // m
+  double replan_deviation = 0.6;  // m off the path -> plan again
   int max_recoveries_per_goal = 5;
-  int max_plan_failures = 3;         // per goal, then the goal is given up
-  double goal_search_radius = 0.6;   // m: a goal in an obstacle's clearance moves at most this far
-  double blocked_clearance = 0.35;   // m: base_link's clearance from a seen obstacle along the path
-                                     // ahead below which it counts as blocked (< robot_radius, which
-                                     // the planner keeps)
-  double blocked_horizon = 4.0;      // m of path ahead checked when the costmap changes
+  int max_plan_failures = 3;        // per goal, then the goal is given up
+  double goal_search_radius = 0.6;  // m: a goal in an obstacle's clearance moves at most this far
+  double blocked_clearance = 0.35;  // m: base_link's clearance from a seen obstacle along the path
+                                    // ahead below which it counts as blocked (< robot_radius, which
+                                    // the planner keeps)
+  double blocked_horizon = 4.0;     // m of path ahead checked when the costmap changes
 };
 
 struct NavigationEvent {
   enum class Type {
-    kPlanned, kPlanFailed, kGoalReached, kGoalFailed, kObstacleStop, kRecovered,
-    kPathBlocked,   // an obstacle seen on the path ahead: plan again
-    kGoalAdjusted,  // the goal was in an obstacle's clearance: `position` is the goal used instead
+    kPlanned,
+    kPlanFailed,
+    kGoalReached,
+    kGoalFailed,
+    kObstacleStop,
+    kRecovered,
+    kPathBlocked,      // an obstacle seen on the path ahead: plan again
+    kGoalAdjusted,     // the goal was in an obstacle's clearance: `position` is the goal used instead
     kApproachReached,  // a bush goal's approach point, reached by map: visual servoing starts
   };
   double stamp = 0.0;

@@ -15,13 +15,13 @@
 namespace trimbot::stack {
 
 struct ObstacleLayerParameters {
-  double size = 12.0;               // m, side of the square window centred on the robot
-  double hit = 0.85;                // log-odds added to a cell stereo saw an obstacle in (one frame)
-  double miss = -0.4;               // log-odds added to a cell seen free (one frame)
-  double occupied = 1.2;            // log-odds above which a cell is an obstacle (p = 0.77)
-  double limit = 3.5;               // |log-odds| is clamped here, so evidence can be overturned
-  double decay_time = 30.0;         // s: log-odds fall by 1/e in this time without new evidence
-  int min_points = 5;               // obstacle points in a cell in one frame for a hit (speckle)
+  double size = 12.0;        // m, side of the square window centred on the robot
+  double hit = 0.85;         // log-odds added to a cell stereo saw an obstacle in (one frame)
+  double miss = -0.4;        // log-odds added to a cell seen free (one frame)
+  double occupied = 1.2;     // log-odds above which a cell is an obstacle (p = 0.77)
+  double limit = 3.5;        // |log-odds| is clamped here, so evidence can be overturned
+  double decay_time = 30.0;  // s: log-odds fall by 1/e in this time without new evidence
+  int min_points = 5;        // obstacle points in a cell in one frame for a hit (speckle)
 };
 
 // What one stereo pair saw, in the map frame.
@@ -52,7 +52,7 @@ class ObstacleLayer {
   // The prior map with this layer's occupied cells added (same size, resolution and origin).
   OccupancyGrid MergedWith(const OccupancyGrid& prior) const;
 
-  const cv::Mat& log_odds() const { return log_odds_; }  // CV_32F, row 0 = smallest y
+  const cv::Mat& log_odds() const { return log_odds_; }      // CV_32F, row 0 = smallest y
   const Eigen::Vector2d& origin() const { return origin_; }  // window's bottom-left corner, map frame
   double resolution() const { return resolution_; }
 

@@ -30,8 +30,8 @@ class OccupancyGrid {
   Eigen::Vector2d size() const { return {occupied_.cols * resolution_, occupied_.rows * resolution_}; }
 
  private:
-  cv::Mat occupied_;   // CV_8U 0/255
-  cv::Mat distance_;   // CV_32F, metres from each cell centre to the nearest occupied cell
+  cv::Mat occupied_;  // CV_8U 0/255
+  cv::Mat distance_;  // CV_32F, metres from each cell centre to the nearest occupied cell
   double resolution_ = 0.05;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
 };

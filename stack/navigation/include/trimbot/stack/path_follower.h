@@ -13,24 +13,24 @@
 namespace trimbot::stack {
 
 struct FollowerParameters {
-  double cruise_speed = 0.25;           // m/s
-  double lookahead = 0.6;               // m along the path
-  double max_angular_speed = 0.6;       // rad/s
-  double align_tolerance = 0.15;        // rad: on a new path, turn on the spot until within this
-  double turn_in_place_above = 0.6;     // rad: heading errors above this turn on the spot first
-  double heading_gain = 1.5;            // 1/s, for turning on the spot
-  double sharp_turn = 0.5;              // rad: path vertices turning more are driven to, not cut
-  double vertex_tolerance = 0.06;       // m: a sharp vertex counts as reached within this
-  double goal_tolerance = 0.08;         // m: arrival, judged on the pose estimate
-  double slow_down_distance = 0.6;      // m before the goal
-  double min_speed = 0.05;              // m/s near the goal
+  double cruise_speed = 0.25;        // m/s
+  double lookahead = 0.6;            // m along the path
+  double max_angular_speed = 0.6;    // rad/s
+  double align_tolerance = 0.15;     // rad: on a new path, turn on the spot until within this
+  double turn_in_place_above = 0.6;  // rad: heading errors above this turn on the spot first
+  double heading_gain = 1.5;         // 1/s, for turning on the spot
+  double sharp_turn = 0.5;           // rad: path vertices turning more are driven to, not cut
+  double vertex_tolerance = 0.06;    // m: a sharp vertex counts as reached within this
+  double goal_tolerance = 0.08;      // m: arrival, judged on the pose estimate
+  double slow_down_distance = 0.6;   // m before the goal
+  double min_speed = 0.05;           // m/s near the goal
 };
 
 struct FollowerOutput {
   messages::BaseVelocityCommand command;
   bool arrived = false;
-  double distance_to_goal = 0.0;   // m, straight line from the estimate
-  double deviation = 0.0;          // m, from the estimate to the nearest point of the path
+  double distance_to_goal = 0.0;  // m, straight line from the estimate
+  double deviation = 0.0;         // m, from the estimate to the nearest point of the path
 };
 
 class PathFollower {
@@ -46,8 +46,8 @@ class PathFollower {
  private:
   FollowerParameters parameters_;
   std::vector<Eigen::Vector2d> path_;
-  std::size_t segment_ = 0;   // progress along the path: never goes back, so loops are not cut
-  bool aligned_ = false;      // has faced along the path since it was set (or since a sharp vertex)
+  std::size_t segment_ = 0;  // progress along the path: never goes back, so loops are not cut
+  bool aligned_ = false;     // has faced along the path since it was set (or since a sharp vertex)
 
   // Index of the first sharp vertex after `segment` (or of the goal).
   std::size_t StretchEnd(std::size_t segment) const;

@@ -14,10 +14,10 @@
 namespace trimbot::perception {
 
 struct ObstaclePointOptions {
-  double min_height = 0.1;        // m above the ground: lower is ground (the base drives over it)
-  double max_height = 1.2;        // m: higher passes over the robot (tree canopies)
-  double ground_tolerance = 0.05; // m: |height| below this is ground
-  double max_position_sigma = 0.1;  // m: points with sqrt(trace(covariance)) above this are dropped
+  double min_height = 0.1;                     // m above the ground: lower is ground (the base drives over it)
+  double max_height = 1.2;                     // m: higher passes over the robot (tree canopies)
+  double ground_tolerance = 0.05;              // m: |height| below this is ground
+  double max_position_sigma = 0.1;             // m: points with sqrt(trace(covariance)) above this are dropped
   Eigen::Vector2d robot_min = {-0.25, -0.35};  // m, base_link box of the robot itself (its base,
   Eigen::Vector2d robot_max = {0.65, 0.35};    //    ring and arm); points inside are not obstacles
   GroundFitOptions ground;
@@ -25,10 +25,10 @@ struct ObstaclePointOptions {
 
 struct ObstaclePoints {
   Eigen::Vector3d sensor = Eigen::Vector3d::Zero();  // base_link position of the camera that saw them
-  GroundPlane ground;                                 // fitted (or base_link's z = 0 if none fitted)
+  GroundPlane ground;                                // fitted (or base_link's z = 0 if none fitted)
   bool ground_fitted = false;
-  std::vector<Eigen::Vector3d> obstacles;             // base_link
-  std::vector<Eigen::Vector3d> ground_points;         // base_link
+  std::vector<Eigen::Vector3d> obstacles;      // base_link
+  std::vector<Eigen::Vector3d> ground_points;  // base_link
 };
 
 // `sensor`: where the cloud was seen from (the rectified left camera's origin), base_link.

@@ -7,8 +7,8 @@
 namespace trimbot::perception {
 
 struct PointCloud {
-  std::vector<Eigen::Vector3d> points;        // m, in the cloud's frame
-  std::vector<Eigen::Matrix3d> covariances;   // m^2, one per point (symmetric positive definite)
+  std::vector<Eigen::Vector3d> points;       // m, in the cloud's frame
+  std::vector<Eigen::Matrix3d> covariances;  // m^2, one per point (symmetric positive definite)
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
@@ -20,7 +20,7 @@ struct PointCloud {
 
 // Points dropped by CleanCloud, by reason.
 struct CleanReport {
-  int non_finite = 0;        // NaN, infinite or absurd (> 1e6 m) coordinates, or NaN covariance
+  int non_finite = 0;           // NaN, infinite or absurd (> 1e6 m) coordinates, or NaN covariance
   int unusable_covariance = 0;  // not symmetric positive definite, or above max_variance
   int kept = 0;
 };

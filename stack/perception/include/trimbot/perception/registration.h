@@ -34,17 +34,17 @@ struct RegistrationOptions {
   // rad + m: the polish stops, converged, when a step moves less than this (1e-3: 0.06 deg, 1 mm,
   // well under the errors that matter; its steps do not shrink much below it)
   double tolerance = 1e-3;
-  int neighbours = 10;              // k nearest target points per source point
+  int neighbours = 10;  // k nearest target points per source point
   // The EM uses at most this many source points (0: all): it only has to find the basin, the
   // polish and the fit use up to 2000 of the full cloud.
   int max_source_points = 500;
-  double truncation_sigmas = 3.0;   // pairs farther apart (Mahalanobis) are left out
-  double outlier_weight = 0.1;      // relative weight of the outlier term in the E-step
+  double truncation_sigmas = 3.0;  // pairs farther apart (Mahalanobis) are left out
+  double outlier_weight = 0.1;     // relative weight of the outlier term in the E-step
   // Annealing: initial extra spread (m); < 0 picks it from the initial misalignment (the median
   // distance of the source points to their nearest target point) and the size of the target
   // (30 % of its RMS radius), whichever is larger.
   double anneal_start = -1.0;
-  double anneal_factor = 0.9;       // per iteration
+  double anneal_factor = 0.9;  // per iteration
   // Covariances given as relative weights (as in the DUGMA Kinect data set) are scaled so that
   // each cloud's median point variance equals the square of its own median point spacing.
   bool relative_covariances = false;
@@ -66,8 +66,8 @@ struct RegistrationOptions {
   // heading (one start); no dominant plane (under 10 % of the points) also leaves one start.
   double heading_search_deg = 0.0;
   double heading_step_deg = 15.0;
-  int polish_iterations = 10;       // Gauss-Newton steps of the fine fit after the EM
-  double max_variance = 1e4;        // m^2 (or relative units); larger marks an unusable point
+  int polish_iterations = 10;  // Gauss-Newton steps of the fine fit after the EM
+  double max_variance = 1e4;   // m^2 (or relative units); larger marks an unusable point
   // Register the pair both ways and call the result untrusted when the two disagree by more than
   // max_inconsistency_deg (twice the time). If both were within 5 deg of the truth they would
   // differ by at most 10: more means at least one is off by more than 5 deg (the success bound).
@@ -83,11 +83,11 @@ struct RegistrationStart {
 
 struct RegistrationResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  // x = transform * y
-  int iterations = 0;               // EM iterations (DUGMA); the stages' budget (ICP: Open3D reports no count)
-  bool converged = false;           // DUGMA: the polish's last step moved less than the tolerance
-  double final_cost = 0.0;          // weighted mean squared Mahalanobis distance of the pairs
-  int pairs = 0;                    // pairs with weight in the last E-step
-  double matched_fraction = 0.0;    // of the source points, those with a pair in the last E-step (DUGMA)
+  int iterations = 0;             // EM iterations (DUGMA); the stages' budget (ICP: Open3D reports no count)
+  bool converged = false;         // DUGMA: the polish's last step moved less than the tolerance
+  double final_cost = 0.0;        // weighted mean squared Mahalanobis distance of the pairs
+  int pairs = 0;                  // pairs with weight in the last E-step
+  double matched_fraction = 0.0;  // of the source points, those with a pair in the last E-step (DUGMA)
   // DUGMA: how well the clouds lie on each other's surface (both ways, averaged over up to 2000
   // points each): the fraction within 3 sigma of the sensors' noise, and the mean log-likelihood
   // ratio of on-surface against outlier, which chooses among the starts.
@@ -111,6 +111,5 @@ class RegistrationError : public std::invalid_argument {
 
 RegistrationResult Register(const PointCloud& target, const PointCloud& source, const Eigen::Isometry3d& initial,
                             const RegistrationOptions& options = {});
-
 
 }  // namespace trimbot::perception

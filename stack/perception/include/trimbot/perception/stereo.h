@@ -24,7 +24,7 @@ struct StereoOptions {
   // Matching. The robot's FPGA runs SGM with 32 disparities: with the rectified f B of 15 px m
   // (f 499 px, B 3 cm) that covers depths from 0.5 m outwards.
   int disparities = 32;
-  int block_size = 5;                 // px, odd
+  int block_size = 5;  // px, odd
   // Quality mode: 64 disparities (from 0.25 m) and full 8-path SGM; otherwise OpenCV's 3-way SGM,
   // which is multithreaded and about ten times faster.
   bool dense = false;
@@ -37,10 +37,10 @@ struct StereoOptions {
   // matches image noise: in the rendered test lawn a quarter of all estimates were such phantom points
   // at 0.5..8 m; the threshold removes them (and distant, blurred lawn with them).
   double min_texture = 0.9;
-  int texture_window = 15;            // px, odd
+  int texture_window = 15;  // px, odd
   // Noise of the measurements the cloud is built from.
-  double disparity_sigma = 0.25;      // px
-  double pixel_sigma = 0.5;           // px, of u and v (pixel quantization)
+  double disparity_sigma = 0.25;  // px
+  double pixel_sigma = 0.5;       // px, of u and v (pixel quantization)
   // Cloud: points outside [min_depth, max_depth] (m, along the rectified optical axis) are
   // dropped, and only every `stride`-th pixel in u and v is used.
   double min_depth = 0.3;
@@ -66,8 +66,8 @@ class StereoRectifier {
   RectifiedPair Rectify(const cv::Mat& left, const cv::Mat& right) const;
 
   const robot::StereoPair& pair() const { return pair_; }
-  double focal_length() const { return focal_length_; }  // px, rectified
-  double baseline() const { return baseline_; }          // m
+  double focal_length() const { return focal_length_; }                 // px, rectified
+  double baseline() const { return baseline_; }                         // m
   Eigen::Vector2d principal_point() const { return principal_point_; }  // px, rectified (both images)
   cv::Size image_size() const { return image_size_; }
   // Pose of the rectified left optical frame (z forward, x right, y down) in base_link.
@@ -164,8 +164,8 @@ struct GroundPlane {
 };
 
 struct GroundFitOptions {
-  double candidate_height = 0.3;   // m: only points with |z| below this (base_link) are tried
-  double inlier_distance = 0.05;   // m
+  double candidate_height = 0.3;  // m: only points with |z| below this (base_link) are tried
+  double inlier_distance = 0.05;  // m
   int iterations = 200;
   std::uint64_t seed = 1;
   double max_tilt_degrees = 20.0;  // planes steeper than this are not ground

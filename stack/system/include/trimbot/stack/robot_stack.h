@@ -14,9 +14,9 @@
 //       (a goal is a point, or Goal::ApproachBush: by map to ~1 m, then visual servoing)
 //       per sensor message: stack.Add(message);   then: commands = stack.Update(now);
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,9 +35,8 @@ namespace trimbot::stack {
 // The stack's visual localizer for `rig` against the map file, configured by `parameters` (one
 // place: the stack and the offline localization benchmarks use the same). Throws InputError naming
 // the file if it is not a map or was made for another rig or descriptor.
-std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const std::string& map_path,
-                                                                         const VisualLocalizationParameters& parameters,
-                                                                         const robot::CameraRig& rig);
+std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(
+    const std::string& map_path, const VisualLocalizationParameters& parameters, const robot::CameraRig& rig);
 
 class RobotStack {
  public:

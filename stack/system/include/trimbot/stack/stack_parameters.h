@@ -5,8 +5,8 @@
 // optional.
 #include <string>
 
-#include "trimbot/common/yaml_reader.h"
 #include "trimbot/arm/arm_executive.h"
+#include "trimbot/common/yaml_reader.h"
 #include "trimbot/perception/bush_estimator.h"
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/perception/obstacle_points.h"
@@ -19,26 +19,26 @@
 namespace trimbot::stack {
 
 enum class LocalizationSource {
-  kNone,                 // EKF of wheel odometry and gyro only
-  kSimulatedPoseFixes,   // PoseFix messages from a test fixture outside the stack
-  kVisual,               // the stack's own visual localization against a pre-built map
+  kNone,                // EKF of wheel odometry and gyro only
+  kSimulatedPoseFixes,  // PoseFix messages from a test fixture outside the stack
+  kVisual,              // the stack's own visual localization against a pre-built map
 };
 
 struct VisualLocalizationParameters {
-  double rate_hz = 2.0;              // frames localized per second at most
-  bool measured_latency = false;     // fixes reach the EKF after the measured processing time, or
-  double latency_median = 0.15;      // ... (deterministic mode) after a seeded log-normal latency
-  double latency_log_sigma = 0.35;   //     like the real pipeline's (Figure 10 of D3.4)
-  double latency_max = 1.5;          // s
-  int features = 1000;               // keypoints per camera image
+  double rate_hz = 2.0;             // frames localized per second at most
+  bool measured_latency = false;    // fixes reach the EKF after the measured processing time, or
+  double latency_median = 0.15;     // ... (deterministic mode) after a seeded log-normal latency
+  double latency_log_sigma = 0.35;  //     like the real pipeline's (Figure 10 of D3.4)
+  double latency_max = 1.5;         // s
+  int features = 1000;              // keypoints per camera image
   visual_localization::Descriptor descriptor = visual_localization::Descriptor::kUprightSift;  // the map's too
-  bool left_cameras_only = true;     // the left camera of each stereo pair: the robot's SLAM used
-                                     // one (grey) camera per pair (D3.4 Section 2.3); all: both
-  double image_scale = 0.5;          // resolution the ring is asked for (0.5: 376x240)
-  int keyframes = 20;                // retrieved keyframes whose points are matched
-  double prior_radius = 3.0;         // m around the EKF's position
+  bool left_cameras_only = true;  // the left camera of each stereo pair: the robot's SLAM used
+                                  // one (grey) camera per pair (D3.4 Section 2.3); all: both
+  double image_scale = 0.5;       // resolution the ring is asked for (0.5: 376x240)
+  int keyframes = 20;             // retrieved keyframes whose points are matched
+  double prior_radius = 3.0;      // m around the EKF's position
   int min_inliers = 12;
-  double max_position_sigma = 0.5;   // m: with a larger EKF uncertainty the robot stops
+  double max_position_sigma = 0.5;  // m: with a larger EKF uncertainty the robot stops
 };
 const char* ToString(LocalizationSource source);
 
@@ -46,10 +46,10 @@ const char* ToString(LocalizationSource source);
 // layer merged with the prior map for navigation.
 struct ObstacleDetectionParameters {
   bool enabled = false;
-  double rate_hz = 2.5;            // pair frames per second
-  double max_bearing = 0.7;        // rad: pairs whose optical axis is this close to the direction
-                                   // of travel (forward, or backward while backing off)
-  int stride = 2;                  // pixel stride of the stereo clouds
+  double rate_hz = 2.5;                     // pair frames per second
+  double max_bearing = 0.7;                 // rad: pairs whose optical axis is this close to the direction
+                                            // of travel (forward, or backward while backing off)
+  int stride = 2;                           // pixel stride of the stereo clouds
   perception::ObstaclePointOptions points;  // the robot's own box comes from the footprint
   ObstacleLayerParameters layer;
 };
@@ -58,10 +58,10 @@ struct ObstacleDetectionParameters {
 // the standoff, then by visual servoing on the bush's centre from stereo. The bush is looked for
 // at rate_hz with the pair facing it once its mapped centre is within sighting_range.
 struct BushApproachParameters {
-  double rate_hz = 2.5;             // bush frames per second
-  double sighting_range = 3.3;      // m from the arm's axis to the mapped centre
-  double approach_margin = 0.4;     // m
-  double max_bearing = 0.45;        // rad: the bush must be this close to a pair's optical axis
+  double rate_hz = 2.5;          // bush frames per second
+  double sighting_range = 3.3;   // m from the arm's axis to the mapped centre
+  double approach_margin = 0.4;  // m
+  double max_bearing = 0.45;     // rad: the bush must be this close to a pair's optical axis
   perception::BushFitOptions fit;
   BushServoParameters servo;
 };

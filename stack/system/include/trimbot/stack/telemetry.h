@@ -40,9 +40,9 @@ struct StackTimings {
 
 // The stack's own visual localization, counted.
 struct VisualLocalizationCounters {
-  int attempts = 0;       // ring frames localized
-  int fixes = 0;          // of which gave a pose
-  int failures = 0;       // no pose (too few features, matches or inliers)
+  int attempts = 0;         // ring frames localized
+  int fixes = 0;            // of which gave a pose
+  int failures = 0;         // no pose (too few features, matches or inliers)
   int stopped_updates = 0;  // control updates the robot stood still for lack of localization
 };
 
@@ -55,55 +55,55 @@ struct ObstacleCounters {
 
 // One frame in which the stack looked for the bush of a bush goal.
 struct BushSighting {
-  double stamp = 0.0;      // of the frame
+  double stamp = 0.0;  // of the frame
   int goal = 0;
-  bool found = false;      // the shape fit gave a centre
-  bool tracked = false;    // and the track took it
+  bool found = false;                                     // the shape fit gave a centre
+  bool tracked = false;                                   // and the track took it
   Eigen::Vector2d centre_base = Eigen::Vector2d::Zero();  // base_link, at the frame's stamp
-  double distance = 0.0;   // m, from the arm's axis to the centre
-  double bearing = 0.0;    // rad, of the centre seen from the arm's axis (base_link's x: 0)
-  double scale = 1.0;      // fitted size / surveyed size
+  double distance = 0.0;                                  // m, from the arm's axis to the centre
+  double bearing = 0.0;  // rad, of the centre seen from the arm's axis (base_link's x: 0)
+  double scale = 1.0;    // fitted size / surveyed size
   int points = 0;
-  std::string failure;     // when not found
+  std::string failure;  // when not found
 };
 
 // The bush approach under way (servo mode, the track as the arm sees it, the target).
 struct BushApproachStatus {
   int goal = -1;
-  std::string mode;               // BushServo's mode
-  double distance = 0.0;          // m: tracked centre from the arm's axis, now (odometry)
-  double bearing = 0.0;           // rad
-  double target_distance = 0.0;   // m: the standoff
-  double target_bearing = 0.0;    // rad
-  int frames = 0, tracked = 0;    // sightings so far for this goal, and taken by the track
+  std::string mode;              // BushServo's mode
+  double distance = 0.0;         // m: tracked centre from the arm's axis, now (odometry)
+  double bearing = 0.0;          // rad
+  double target_distance = 0.0;  // m: the standoff
+  double target_bearing = 0.0;   // rad
+  int frames = 0, tracked = 0;   // sightings so far for this goal, and taken by the track
 };
 
 // The arm's goals under way.
 struct ArmStatus {
-  std::string mode;              // ArmExecutive's mode
-  int goal = 0;                  // index into the arm goals
-  int perceived_cells = 0;       // occupied cells of the environment the planner avoids
-  std::vector<double> target;    // rad: the joint targets commanded now (empty when not moving)
+  std::string mode;            // ArmExecutive's mode
+  int goal = 0;                // index into the arm goals
+  int perceived_cells = 0;     // occupied cells of the environment the planner avoids
+  std::vector<double> target;  // rad: the joint targets commanded now (empty when not moving)
 };
 
 // What the stack reports after an update, for logs and evaluation.
 struct Telemetry {
   double stamp = 0.0;
-  PoseEstimate estimate;                 // EKF, map frame
-  Pose2 odometry;                        // wheel odometry alone, map frame (odom = initial pose)
+  PoseEstimate estimate;  // EKF, map frame
+  Pose2 odometry;         // wheel odometry alone, map frame (odom = initial pose)
   MissionState mission = MissionState::kIdle;
   int current_goal = 0;
-  std::vector<NavigationEvent> events;   // of the last update
-  EkfCounters localization;              // fixes accepted, rejected, re-localizations
-  int ring_frames = 0;                   // received
-  int pose_fixes_ignored = 0;            // received while no fix source is configured
+  std::vector<NavigationEvent> events;                        // of the last update
+  EkfCounters localization;                                   // fixes accepted, rejected, re-localizations
+  int ring_frames = 0;                                        // received
+  int pose_fixes_ignored = 0;                                 // received while no fix source is configured
   std::optional<perception::CloudRegistration> registration;  // local fusion, in the last update
-  std::vector<messages::PoseFix> visual_fixes;  // the stack's own fixes applied in the last update
+  std::vector<messages::PoseFix> visual_fixes;                // the stack's own fixes applied in the last update
   VisualLocalizationCounters visual;
   ObstacleCounters obstacles;
-  std::vector<BushSighting> bush_sightings;   // looked for in the frames since the last update
-  std::optional<BushApproachStatus> bush;     // while a bush goal is the current one
-  std::optional<ArmStatus> arm;               // with arm goals
+  std::vector<BushSighting> bush_sightings;     // looked for in the frames since the last update
+  std::optional<BushApproachStatus> bush;       // while a bush goal is the current one
+  std::optional<ArmStatus> arm;                 // with arm goals
   std::vector<arm::ArmGoalResult> arm_results;  // arm goals finished in the last update
   StackTimings timings;
 };

@@ -26,7 +26,7 @@ const char* ToString(Descriptor descriptor);
 Descriptor DescriptorFromString(const std::string& name);
 
 struct FeatureOptions {
-  int max_features = 2000;   // strongest keypoints kept per image
+  int max_features = 2000;  // strongest keypoints kept per image
   Descriptor descriptor = Descriptor::kUprightSift;
 };
 

@@ -28,13 +28,13 @@ enum class Retrieval { kVocabulary, kPosePrior, kCombined };
 struct LocalizerOptions {
   FeatureOptions features{1000, Descriptor::kUprightSift};
   Retrieval retrieval = Retrieval::kCombined;
-  int keyframes = 20;            // top-k retrieved keyframes whose points are matched
-  double prior_radius = 3.0;     // m: with a pose prior, only keyframes this close are candidates
-  double ratio = 0.8;            // Lowe's ratio test
+  int keyframes = 20;         // top-k retrieved keyframes whose points are matched
+  double prior_radius = 3.0;  // m: with a pose prior, only keyframes this close are candidates
+  double ratio = 0.8;         // Lowe's ratio test
   RigPoseOptions pose;
-  std::vector<int> cameras;      // ring cameras used (empty: every camera in the frame)
-  double min_position_sigma = 0.02;          // m: floor of the reported covariance
-  double min_yaw_sigma = 0.5 * M_PI / 180;   // rad
+  std::vector<int> cameras;                 // ring cameras used (empty: every camera in the frame)
+  double min_position_sigma = 0.02;         // m: floor of the reported covariance
+  double min_yaw_sigma = 0.5 * M_PI / 180;  // rad
 };
 
 struct LocalizationTimings {
@@ -46,7 +46,7 @@ struct LocalizationResult {
   double stamp = 0.0;
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
   Eigen::Matrix3d planar_covariance = Eigen::Matrix3d::Identity();  // of (x, y, yaw)
-  std::vector<int> retrieved;          // keyframe ids, best first
+  std::vector<int> retrieved;                                       // keyframe ids, best first
   int features = 0, matches = 0, inliers = 0;
   LocalizationTimings timings;
   std::string failure;

@@ -26,27 +26,27 @@ namespace trimbot::visual_localization {
 
 struct MapBuilderOptions {
   FeatureOptions features;
-  double keyframe_distance = 0.3;             // m of survey motion between keyframes
-  double keyframe_angle = 10.0 * M_PI / 180;  // rad
-  int match_next_keyframes = 3;               // each keyframe is matched with this many following ones
-  double max_camera_angle = 60.0 * M_PI / 180;  // rad between optical axes of two matched images
-  double ratio = 0.8;                         // Lowe's ratio test
-  double epipolar_angle = 0.015;              // rad from the epipolar plane of the survey poses
-  double survey_position_sigma = 0.02;        // m, prior of each keyframe's position
+  double keyframe_distance = 0.3;                   // m of survey motion between keyframes
+  double keyframe_angle = 10.0 * M_PI / 180;        // rad
+  int match_next_keyframes = 3;                     // each keyframe is matched with this many following ones
+  double max_camera_angle = 60.0 * M_PI / 180;      // rad between optical axes of two matched images
+  double ratio = 0.8;                               // Lowe's ratio test
+  double epipolar_angle = 0.015;                    // rad from the epipolar plane of the survey poses
+  double survey_position_sigma = 0.02;              // m, prior of each keyframe's position
   double survey_rotation_sigma = 0.5 * M_PI / 180;  // rad
-  double pixel_sigma = 1.0;                   // px
-  double max_reprojection_error = 4.0;        // px: observations worse after adjustment are dropped
+  double pixel_sigma = 1.0;                         // px
+  double max_reprojection_error = 4.0;              // px: observations worse after adjustment are dropped
   double min_triangulation_angle = 1.0 * M_PI / 180;
-  double max_depth = 25.0;                    // m
+  double max_depth = 25.0;  // m
   int vocabulary_words = 256;
   int adjustment_iterations = 30;
 };
 
 struct MapBuildStats {
   int frames = 0, keyframes = 0, images_matched = 0, matches = 0, tracks = 0, points = 0, observations = 0;
-  int outlier_observations = 0;                 // dropped after the first adjustment
+  int outlier_observations = 0;  // dropped after the first adjustment
   double mean_track_length = 0.0;
-  double reprojection_rmse_px = 0.0;            // after the second adjustment, over the observations kept
+  double reprojection_rmse_px = 0.0;  // after the second adjustment, over the observations kept
   double seconds_features = 0.0, seconds_matching = 0.0, seconds_adjustment = 0.0, seconds_vocabulary = 0.0;
 };
 

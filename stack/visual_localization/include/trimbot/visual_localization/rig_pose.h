@@ -10,14 +10,14 @@
 namespace trimbot::visual_localization {
 
 struct Correspondence {
-  int camera = 0;             // index into the rig's cameras
-  Eigen::Vector3d bearing;    // unit ray in that camera's optical frame (z forward)
-  Eigen::Vector3d point;      // map point (map frame)
+  int camera = 0;           // index into the rig's cameras
+  Eigen::Vector3d bearing;  // unit ray in that camera's optical frame (z forward)
+  Eigen::Vector3d point;    // map point (map frame)
 };
 
 struct RigPoseOptions {
-  double inlier_angle = 0.004;   // rad: ~2 px at f = 500 px
-  double angle_sigma = 0.002;    // rad: the bearings' noise, for the covariance
+  double inlier_angle = 0.004;  // rad: ~2 px at f = 500 px
+  double angle_sigma = 0.002;   // rad: the bearings' noise, for the covariance
   int max_iterations = 500;
   int min_inliers = 12;
 };
@@ -25,8 +25,9 @@ struct RigPoseOptions {
 struct RigPoseResult {
   bool success = false;
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
-  std::vector<int> inliers;                     // indices into the correspondences
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Identity();  // (rotation, translation) of base_link, left-perturbed
+  std::vector<int> inliers;  // indices into the correspondences
+  Eigen::Matrix<double, 6, 6> covariance =
+      Eigen::Matrix<double, 6, 6>::Identity();  // (rotation, translation) of base_link, left-perturbed
   std::string failure;                          // why not, when !success
 };
 

@@ -24,21 +24,21 @@ struct MapKeyframe {
 };
 
 struct MapObservation {
-  int keyframe = 0;    // keyframe id
-  int camera = 0;      // ring camera index
-  int point = 0;       // point id
+  int keyframe = 0;                                 // keyframe id
+  int camera = 0;                                   // ring camera index
+  int point = 0;                                    // point id
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // distorted image coordinates
 };
 
 struct VisualMap {
-  std::string garden;          // the garden the map was made in
-  std::string rig_signature;   // RigSignature() of the calibration it was made with
+  std::string garden;                                // the garden the map was made in
+  std::string rig_signature;                         // RigSignature() of the calibration it was made with
   Descriptor descriptor = Descriptor::kUprightSift;  // of the points and the vocabulary
   std::vector<MapKeyframe> keyframes;
   std::vector<Eigen::Vector3d> points;  // map frame; id = index
   cv::Mat descriptors;                  // CV_32F, one row per point
   std::vector<MapObservation> observations;
-  cv::Mat vocabulary;                   // CV_32F, one row per visual word
+  cv::Mat vocabulary;  // CV_32F, one row per visual word
 
   // Writes the map atomically. Throws std::runtime_error naming the file on failure.
   void Save(const std::string& path) const;
