@@ -1,6 +1,6 @@
 #pragma once
 // The options by which `run`, `sweep` and `tune` hand their batches to a Slurm cluster instead of
-// running them here (runner/slurm_executor.h).
+// running them here (runners/slurm_executor.h).
 #include <CLI/CLI.hpp>
 
 #include <memory>

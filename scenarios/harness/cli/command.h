@@ -30,7 +30,7 @@ class Commands {
   ProjectPaths paths() const { return {data_root_}; }
   // `run` runs `command` when the arguments named it; it returns the exit code.
   void OnRun(CLI::App* command, std::function<int()> run);
-  // Parses argv (ParseArguments) and runs the command it named; returns the exit code. Bad input
+  // Parses argv and runs the command it named; returns the exit code. Bad input
   // (InputError) is printed and gives kExitBadInput, any other exception kExitInternalError.
   int ParseAndRun(int argc, char** argv);
 
@@ -51,14 +51,5 @@ void AddTuningCommands(Commands& commands);  // sweep, tune
 void AddMapCommands(Commands& commands);     // map build | ensure | bench | retrieval-eval
 void AddFusionCommand(Commands& commands);
 void AddStereoCommand(Commands& commands);
-
-// Adds to every numeric option of `app` and its subcommands, whatever its own checks: floating
-// point values must be finite (CLI11's Range lets NaN through, since NaN < lo is false), unsigned
-// ones must not be negative (CLI11 would wrap -1 to 2^64 - 1). Call once all options exist.
-void CheckEveryNumber(CLI::App& app);
-
-// Parses argv; usage errors are printed and mapped to kExitBadInput, --help to kExitSuccess. An
-// unknown command is named. Returns -1 when parsing succeeded and the command should run.
-int ParseArguments(CLI::App& app, int argc, char** argv);
 
 }  // namespace trimbot::scenarios

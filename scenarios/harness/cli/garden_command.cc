@@ -15,10 +15,7 @@ struct GardenOptions {
   double ground_z = 0.0;
   garden::GeneratorParameters generator;
   std::string size = "16x12";
-  double resolution = 0.05;
-  double clearance = 1.0;
-  double growth = 0.0;
-  double point_density = 400.0;
+  GardenExport exported;  // `garden export`'s options, as the runner takes them
 };
 
 }  // namespace
@@ -64,27 +61,19 @@ void AddGardenCommands(Commands& commands) {
   });
 
   auto* export_cmd = garden_cmd->add_subcommand("export", "write the occupancy map (map_server) and ground-truth PLY");
-  export_cmd->add_option("garden", options->input, "garden name or file")->required();
-  export_cmd->add_option("--out", options->output, "output folder")->required();
-  export_cmd->add_option("--resolution", options->resolution, "occupancy cell size (m)")
+  GardenExport& exported = options->exported;
+  export_cmd->add_option("garden", exported.garden, "garden name or file")->required();
+  export_cmd->add_option("--out", exported.output_dir, "output folder")->required();
+  export_cmd->add_option("--resolution", exported.resolution, "occupancy cell size (m)")
       ->check(CLI::Range(0.005, 10.0));
   export_cmd
-      ->add_option("--clearance", options->clearance,
+      ->add_option("--clearance", exported.clearance,
                    "objects starting higher than this (tree crowns) are not obstacles (m)")
       ->check(CLI::Range(0.0, 100.0));
-  export_cmd->add_option("--growth", options->growth, "seasonal growth 0..1")->check(CLI::Range(0.0, 1.0));
-  export_cmd->add_option("--points-per-m2", options->point_density, "PLY sampling density")
+  export_cmd->add_option("--growth", exported.growth, "seasonal growth 0..1")->check(CLI::Range(0.0, 1.0));
+  export_cmd->add_option("--points-per-m2", exported.point_density, "PLY sampling density")
       ->check(CLI::Range(1.0, 1e5));
-  commands.OnRun(export_cmd, [options, &commands] {
-    GardenExport exported;
-    exported.garden = options->input;
-    exported.output_dir = options->output;
-    exported.resolution = options->resolution;
-    exported.clearance = options->clearance;
-    exported.growth = options->growth;
-    exported.point_density = options->point_density;
-    return ExportGarden(exported, commands.paths());
-  });
+  commands.OnRun(export_cmd, [options, &commands] { return ExportGarden(options->exported, commands.paths()); });
 }
 
 }  // namespace trimbot::scenarios

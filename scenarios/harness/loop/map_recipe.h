@@ -9,7 +9,7 @@ namespace trimbot::scenarios {
 
 // What a map is made from: the mapping drive and the survey. A scenario may name one instead of a
 // map file (`visual_map: {mapping_drive: PLAN}`); the map is then built on first use and cached
-// (runner/map_cache.h).
+// (runners/map_cache.h).
 struct MapRecipe {
   std::string plan_path;                // the mapping drive: a drive plan, or a scenario with goals
   std::optional<std::uint64_t> seed;    // the drive's (and the survey noise's) seed; default: the plan's

@@ -89,7 +89,7 @@ CalibrationError ReadCalibrationError(const YamlMap& map) {
 }
 
 // `visual_map: PATH` (a built map file) or `visual_map: {mapping_drive: PLAN, ...}` (a map built on
-// first use from that drive and cached: runner/map_cache.h). Paths are relative to the scenario.
+// first use from that drive and cached: runners/map_cache.h). Paths are relative to the scenario.
 void ReadVisualMap(const YamlMap& root, Scenario& s) {
   const auto relative_to_scenario = [&](const std::filesystem::path& path) {
     return (path.is_absolute() ? path : std::filesystem::path(s.source).parent_path() / path).string();

@@ -1,6 +1,6 @@
 #pragma once
 // Where batches run: here, as child processes of this one (RunBatch), or spread over a cluster
-// (runner/slurm_executor.h). `run`, `sweep` and `tune` hand their batches to an executor, so the
+// (runners/slurm_executor.h). `run`, `sweep` and `tune` hand their batches to an executor, so the
 // same command scales out without a second code path for the trials. Whatever runs them, each
 // batch's output folder ends up the same: summary.json is byte-identical for the same scenario,
 // overrides and seeds.
