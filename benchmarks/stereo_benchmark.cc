@@ -27,7 +27,7 @@ const Scene& RenderedScene() {
   static const Scene scene = [] {
     sim::SimulatorConfig config;
     config.robot = trimbot::robot::RobotFiles::InFolder(SourcePath("robot"));
-    config.garden_path = SourcePath("garden_scenes/gardens/test_lawn.yaml");
+    config.garden = garden::Garden::Load(SourcePath("garden_scenes/gardens/test_lawn.yaml"));
     config.world_dir = (std::filesystem::temp_directory_path() / "trimbot_stereo_benchmark_world").string();
     config.seed = 1;
     config.render_cameras = true;

@@ -75,7 +75,7 @@ criteria:
 void LoadScenario(const std::string& path) {
   const Scenario scenario = Scenario::Load(path);
   StackParametersFor(scenario, kPaths);  // the stack section's keys
-  ResolveGarden(scenario.world, kPaths);
+  ResolveGarden(scenario.setting, kPaths);
 }
 
 TEST(BadInput, ScenarioValuesAreCheckedAndNamed) {

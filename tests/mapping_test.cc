@@ -136,10 +136,11 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   const scenarios::DrivePlan plan =
       scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
-  scenarios::WorldSetup world = plan.world;
-  world.seed = 77;
-  sim::SimulatorConfig config =
-      scenarios::MakeSimulatorConfig({TRIMBOT_SOURCE_DIR}, world, testing::TempDir("map_query"));
+  scenarios::Setting setting = plan.setting;
+  setting.seed = 77;
+  sim::SimulatorConfig config = scenarios::MakeSimulatorConfig({TRIMBOT_SOURCE_DIR}, setting,
+                                                               scenarios::LoadGarden(setting, {TRIMBOT_SOURCE_DIR}),
+                                                               testing::TempDir("map_query"));
   config.cameras_on_schedule = false;
   sim::Simulator simulator(config);
   scenarios::DrivePlanPlayer player(plan, 4.1);

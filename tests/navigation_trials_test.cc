@@ -48,7 +48,7 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
     EXPECT_EQ(s.name, name);
     EXPECT_EQ(s.goals.size(), 4u);
     EXPECT_EQ(s.trials, 6);
-    EXPECT_NEAR((s.goals.back().position - Eigen::Vector2d(s.world.start.x, s.world.start.y)).norm(), 0.0, 1e-9)
+    EXPECT_NEAR((s.goals.back().position - Eigen::Vector2d(s.setting.start.x, s.setting.start.y)).norm(), 0.0, 1e-9)
         << "a loop";
     ASSERT_TRUE(s.stack.has_value());
     EXPECT_EQ(StackParametersFor(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).localization,
@@ -62,10 +62,10 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
 // trials, it has to plan around the bushes).
 TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
   const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/hourglass.yaml"));
-  const garden::OccupancyMap prior = PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
+  const garden::OccupancyMap prior = PrepareTrial(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const double radius = stack::PlannerParameters{}.robot_radius;
-  Eigen::Vector2d from(s.world.start.x, s.world.start.y);
+  Eigen::Vector2d from(s.setting.start.x, s.setting.start.y);
   for (const auto& scenario_goal : s.goals) {
     const Eigen::Vector2d goal = scenario_goal.position;
     EXPECT_GE(map.DistanceToObstacle(goal), radius) << "goal " << goal.transpose() << " is not reachable";
@@ -110,10 +110,10 @@ TEST(PriorKnowledge, TheMapIsTheGardenAsSurveyed) {
 TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
   Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle.yaml"));
-  const stack::Pose2 a = BelievedStart(s, 1), b = BelievedStart(s, 1), c = BelievedStart(s, 2);
+  const Pose2 a = BelievedStart(s, 1), b = BelievedStart(s, 1), c = BelievedStart(s, 2);
   EXPECT_EQ(a.x, b.x);
   EXPECT_NE(a.x, c.x);
-  const double error = std::hypot(a.x - s.world.start.x, a.y - s.world.start.y);
+  const double error = std::hypot(a.x - s.setting.start.x, a.y - s.setting.start.y);
   EXPECT_GT(error, 0.0);
   EXPECT_LT(error, 5 * s.initial_position_sigma);
 
@@ -170,7 +170,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
            {"{approach_bush: 999}", "has no object 999"}, {"{approach_bush: 5}", "is a hedge, not a bush"}}) {
     const Scenario s = Scenario::Load(SmokeVariant("bad_bush.yaml", "\\{x: 4.0, y: 0.0\\}", goal));
     try {
-      PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
+      PrepareTrial(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
       ADD_FAILURE() << goal << " accepted";
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("bad_bush.yaml"), std::string::npos) << e.what();
@@ -179,7 +179,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
   }
   // A real bush gives the stack its surveyed centre and shape.
   const Scenario ok = Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0\\}", "{approach_bush: 3}"));
-  const std::vector<stack::Goal> goals = PrepareTrialWorld(ok, ProjectPaths{TRIMBOT_SOURCE_DIR}).mission;
+  const std::vector<stack::Goal> goals = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR}).mission;
   ASSERT_EQ(goals.size(), 1u);
   ASSERT_TRUE(goals[0].bush.has_value());
   EXPECT_EQ(goals[0].bush->kind, perception::BushShape::Kind::kCylinder);
@@ -191,7 +191,7 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
 // time; the planner now arrives from a side that works.
 TEST(Planner, ReachesAGoalOnlySomeHeadingsCanArriveAt) {
   Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle.yaml"));
-  const garden::OccupancyMap prior = PrepareTrialWorld(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
+  const garden::OccupancyMap prior = PrepareTrial(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
   const stack::GlobalPlanner planner(
       map, stack::StackParameters::Load(testing::SourcePath("robot/config/stack.yaml")).navigation.planner);
@@ -242,7 +242,7 @@ TEST(Trial, FaultsAreInjectedAndShowInTheResult) {
   const std::string out = testing::TempDir("trial_faults");
   Scenario clean =
       Scenario::Load(SmokeVariant("fixes.yaml", "localization: none", "localization: simulated_pose_fixes"));
-  const TrialWorld world = PrepareTrialWorld(clean, paths);  // the faults change nothing of it
+  const PreparedTrial world = PrepareTrial(clean, paths);  // the faults change nothing of it
   WritePriorMap(world.prior_map, out + "/map");
 
   Scenario faulty = clean;

@@ -9,7 +9,7 @@ inline sim::SimulatorConfig TestConfig(const std::string& garden_file, const std
                                        bool cameras = false) {
   sim::SimulatorConfig config;
   config.robot = robot::RobotFiles::InFolder(SourcePath("robot"));
-  config.garden_path = garden_file;
+  config.garden = garden::Garden::Load(garden_file);
   config.world_dir = TempDir(world_name);
   config.seed = 1;
   config.render_cameras = cameras;

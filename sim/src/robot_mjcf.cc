@@ -31,7 +31,7 @@ class MjcfEmitter {
   MjcfEmitter(const robot::RobotDescription& robot, const robot::CameraRig& rig, double oversampling)
       : robot_(robot), rig_(rig), oversampling_(oversampling) {}
 
-  std::string RobotBody(const Pose2D& start) {
+  std::string RobotBody(const Pose2& start) {
     const auto& root = *robot_.urdf().getRoot();
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.translation() << start.x, start.y, 0.0;

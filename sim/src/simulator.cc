@@ -23,13 +23,13 @@ using robot::RobotFrames;
 
 namespace {
 
-// The garden file's objects plus the configuration's extra ones.
+// The garden's objects plus the configuration's extra ones.
 garden::Garden GardenWithExtraObjects(const SimulatorConfig& config) {
-  garden::Garden garden = garden::Garden::Load(config.garden_path);
+  garden::Garden garden = config.garden;
   try {
     garden.AddObjects(config.extra_objects);
   } catch (const std::invalid_argument& e) {
-    throw InputError(config.garden_path, std::string("an extra object: ") + e.what());
+    throw InputError(garden.source.empty() ? garden.name : garden.source, std::string("an extra object: ") + e.what());
   }
   return garden;
 }
@@ -452,7 +452,7 @@ std::vector<CollisionHull> Simulator::GardenCollisionHulls() const {
   return hulls;
 }
 
-void Simulator::PlaceRobot(const Pose2D& pose) {
+void Simulator::PlaceRobot(const Pose2& pose) {
   World& world = *impl_->world;
   const mjModel* m = world.model();
   mjData* d = world.data();

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "runners/exit_code.h"
 
 namespace trimbot::scenarios {

@@ -1,6 +1,8 @@
 // `trimbot sweep` and `trimbot tune`: parameter sweeps and derivative-free tuning of a scenario
 // (runners/sweep.h, runners/tune.h).
+#include <cstdint>
 #include <memory>
+#include <string>
 
 #include "cli/command.h"
 
@@ -11,38 +13,45 @@
 namespace trimbot::scenarios {
 namespace {
 
-void AddSweep(Commands& commands) {
-  CLI::App& app = commands.app();
-  auto options = std::make_shared<SweepOptions>();
+// What sweep and tune share: each point or evaluation is a batch of `--trials` trials from
+// `--seed`, `--jobs` at once, with `--set` overrides, here or on a cluster. Adds those options to
+// `command` and runs `run(*options)` with them.
+template <class Options>
+void AddBatchOptionsAndRun(Commands& commands, CLI::App* command, std::shared_ptr<Options> options,
+                           const std::string& per, int (*run)(const Options&)) {
   auto trials = std::make_shared<int>(0);
   auto seed = std::make_shared<std::uint64_t>(0);
-  auto* sweep = app.add_subcommand("sweep", "run a scenario over the product of parameter grids, with 95 % intervals");
-  sweep->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
-  sweep->add_option("--grid", options->grids, "key.path=v1,v2,... (repeatable; the product is swept)")->required();
-  sweep->add_option("--out", options->out_dir, "output folder")->required();
-  auto* trials_option = sweep->add_option("--trials", *trials, "trials per point (default: the scenario's)")
+  auto* trials_option = command->add_option("--trials", *trials, "trials per " + per + " (default: the scenario's)")
                             ->check(CLI::Range(1, 100000));
-  auto* seed_option = sweep->add_option("--seed", *seed, "batch seed of every point (default: the scenario's)");
-  sweep->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
+  auto* seed_option = command->add_option("--seed", *seed, "batch seed of every " + per + " (default: the scenario's)");
+  command->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
       ->check(CLI::Range(1, 256));
-  sweep->add_option("--set", options->overrides, "override for every point, key.path=value (repeatable)");
-  auto cluster = AddClusterOptions(sweep);
-  commands.OnRun(sweep, [options, trials, seed, trials_option, seed_option, cluster, &commands] {
+  command->add_option("--set", options->overrides, "override for every " + per + ", key.path=value (repeatable)");
+  auto cluster = AddClusterOptions(command);
+  commands.OnRun(command, [options, trials, seed, trials_option, seed_option, cluster, run, &commands] {
     options->paths = commands.paths();
     if (trials_option->count() > 0) options->trials = *trials;
     if (seed_option->count() > 0) options->seed = *seed;
     const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
     options->executor = executor.get();
-    return RunSweep(*options);
+    return run(*options);
   });
 }
 
+void AddSweep(Commands& commands) {
+  auto options = std::make_shared<SweepOptions>();
+  auto* sweep =
+      commands.app().add_subcommand("sweep", "run a scenario over the product of parameter grids, with 95 % intervals");
+  sweep->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
+  sweep->add_option("--grid", options->grids, "key.path=v1,v2,... (repeatable; the product is swept)")->required();
+  sweep->add_option("--out", options->out_dir, "output folder")->required();
+  AddBatchOptionsAndRun(commands, sweep, options, "point", &RunSweep);
+}
+
 void AddTune(Commands& commands) {
-  CLI::App& app = commands.app();
   auto options = std::make_shared<TuneOptions>();
-  auto trials = std::make_shared<int>(0);
-  auto seed = std::make_shared<std::uint64_t>(0);
-  auto* tune = app.add_subcommand("tune", "tune parameters of a scenario with a derivative-free optimizer (NLopt)");
+  auto* tune =
+      commands.app().add_subcommand("tune", "tune parameters of a scenario with a derivative-free optimizer (NLopt)");
   tune->add_option("scenario", options->scenario_path, "scenario file (YAML)")->required();
   tune->add_option("--space", options->space_path,
                    "parameter space (YAML: parameters with key, min, max, log, integer)")
@@ -52,22 +61,8 @@ void AddTune(Commands& commands) {
   tune->add_flag("--maximize", options->maximize, "maximize the objective (default: minimize)");
   tune->add_option("--method", options->method, "bobyqa (local) or direct (global DIRECT-L)");
   tune->add_option("--budget", options->budget_trials, "trials the search may use")->check(CLI::Range(1, 1000000));
-  auto* trials_option = tune->add_option("--trials", *trials, "trials per evaluation (default: the scenario's)")
-                            ->check(CLI::Range(1, 100000));
-  auto* seed_option = tune->add_option("--seed", *seed, "seed of the tuning trials (the same at every point)");
-  tune->add_option("--jobs", options->jobs, "trials in parallel (processes; default: one per hardware thread)")
-      ->check(CLI::Range(1, 256));
   tune->add_option("--out", options->out_dir, "output folder")->required();
-  tune->add_option("--set", options->overrides, "override for every evaluation, key.path=value (repeatable)");
-  auto cluster = AddClusterOptions(tune);
-  commands.OnRun(tune, [options, trials, seed, trials_option, seed_option, cluster, &commands] {
-    options->paths = commands.paths();
-    if (trials_option->count() > 0) options->trials = *trials;
-    if (seed_option->count() > 0) options->seed = *seed;
-    const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
-    options->executor = executor.get();
-    return RunTune(*options);
-  });
+  AddBatchOptionsAndRun(commands, tune, options, "evaluation", &RunTune);
 }
 
 }  // namespace

@@ -37,9 +37,10 @@ robot::CollisionCheckOptions EnvironmentClearance() {
 
 }  // namespace
 
-ArmWorld MakeArmWorld(const Scenario& scenario, const sim::Simulator& simulator, const Eigen::Isometry3d& T_map_base) {
+ArmCollisionTruth MakeArmCollisionTruth(const Scenario& scenario, const sim::Simulator& simulator,
+                                        const Eigen::Isometry3d& T_map_base) {
   const ArmReach& spec = *scenario.arm_reach;
-  ArmWorld world{
+  ArmCollisionTruth truth{
       robot::CollisionModel(simulator.robot(), simulator.robot().ArmJointNames()), {}, {}, simulator.garden().name};
   const auto& objects = simulator.garden().objects;
   const auto bush =
@@ -51,30 +52,30 @@ ArmWorld MakeArmWorld(const Scenario& scenario, const sim::Simulator& simulator,
     throw InputError(scenario.source, what + "object " + std::to_string(spec.bush) + " is a " +
                                           garden::ToString(bush->object_class) + ", not a bush (topiary or rose)");
   }
-  world.bush_centre << bush->position, bush->base_height + 0.5 * bush->size.z();
+  truth.bush_centre << bush->position, bush->base_height + 0.5 * bush->size.z();
   for (const sim::CollisionHull& hull : simulator.GardenCollisionHulls()) {
     const bool near = std::any_of(hull.vertices.begin(), hull.vertices.end(), [&](const Eigen::Vector3d& v) {
       return (v.head<2>() - T_map_base.translation().head<2>()).norm() < kWorldRadius;
     });
     if (!near) continue;
-    if (hull.object_id == spec.bush) world.bush.push_back(world.model.environment().size());
-    world.model.environment().AddConvex(hull.geom, hull.vertices, hull.triangles);
+    if (hull.object_id == spec.bush) truth.bush.push_back(truth.model.environment().size());
+    truth.model.environment().AddConvex(hull.geom, hull.vertices, hull.triangles);
   }
-  if (world.bush.empty()) {
+  if (truth.bush.empty()) {
     throw InputError(scenario.source, what + "the bush is farther than " + std::to_string(kWorldRadius) +
                                           " m from the start: out of the arm's reach");
   }
-  world.model.environment().AddGround("ground", 0.0);
-  return world;
+  truth.model.environment().AddGround("ground", 0.0);
+  return truth;
 }
 
-std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const ArmWorld& world,
+std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const ArmCollisionTruth& truth,
                                                 const robot::RobotDescription& robot,
                                                 const Eigen::Isometry3d& T_map_base, std::uint64_t seed) {
   const ArmReach& spec = *scenario.arm_reach;
   // Each garden and bush its own stream: with the same seed, two bushes of a similar size would
   // otherwise share the poses both accept.
-  Rng rng = MakeRng(seed, "arm_reach_poses/" + world.garden + "/" + std::to_string(spec.bush));
+  Rng rng = MakeRng(seed, "arm_reach_poses/" + truth.garden + "/" + std::to_string(spec.bush));
   const auto uniform = [&rng]() { return UniformUnit(rng); };
   const std::vector<std::string> names = robot.ArmJointNames();
   std::vector<ArmReachPose> poses;
@@ -94,19 +95,19 @@ std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const 
     const Eigen::Isometry3d T_base_cutter = robot.FramePose(robot::RobotFrames::kEndEffector, joints);
     const Eigen::Isometry3d T_map_cutter = T_map_base * T_base_cutter;
     const Eigen::Vector3d tip = T_map_cutter.translation();
-    const Eigen::Vector3d to_centre = world.bush_centre - tip;
+    const Eigen::Vector3d to_centre = truth.bush_centre - tip;
     if (to_centre.norm() > 1.5) continue;
     if (std::acos(std::clamp(T_map_cutter.linear().col(2).dot(to_centre.normalized()), -1.0, 1.0)) > spec.max_tilt)
       continue;
     double surface = 1e9;
-    for (int index : world.bush) surface = std::min(surface, world.model.environment().DistanceTo(index, tip));
+    for (int index : truth.bush) surface = std::min(surface, truth.model.environment().DistanceTo(index, tip));
     if (surface < spec.distance_min || surface > spec.distance_max) continue;
     const bool distinct = std::none_of(poses.begin(), poses.end(), [&](const ArmReachPose& p) {
       return (p.cutter_base.translation() - T_base_cutter.translation()).norm() < kDistinctPoses;
     });
     if (!distinct) continue;
-    if (world.model.Check(q, SelfOnly(), T_map_base).collision) continue;
-    const robot::CollisionReport report = world.model.Check(q, EnvironmentClearance(), T_map_base);
+    if (truth.model.Check(q, SelfOnly(), T_map_base).collision) continue;
+    const robot::CollisionReport report = truth.model.Check(q, EnvironmentClearance(), T_map_base);
     if (report.collision || report.clearance < spec.min_clearance) continue;
     poses.push_back({T_base_cutter, q, report.clearance, surface});
   }
@@ -119,9 +120,9 @@ std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const 
   return poses;
 }
 
-ArmReachEvaluator::ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachPose> poses, ArmWorld* world,
+ArmReachEvaluator::ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachPose> poses, ArmCollisionTruth* truth,
                                      std::function<void(int)> on_reached)
-    : spec_(spec), poses_(std::move(poses)), world_(world), on_reached_(std::move(on_reached)) {
+    : spec_(spec), poses_(std::move(poses)), truth_(truth), on_reached_(std::move(on_reached)) {
   for (size_t i = 0; i < poses_.size(); ++i) {
     ArmGoalOutcome outcome;
     outcome.goal = static_cast<int>(i);
@@ -161,7 +162,7 @@ void ArmReachEvaluator::Observe(const StepView& step) {
   // The true clearance, at about 20 Hz while a goal is worked on.
   const long every = std::max(1L, std::lround(0.05 / std::max(step.timestep, 1e-6)));
   if (current_ < static_cast<int>(outcomes_.size()) && steps_++ % every == 0) {
-    const double clearance = world_->model.Check(q, EnvironmentClearance(), truth.T_map_base).clearance;
+    const double clearance = truth_->model.Check(q, EnvironmentClearance(), truth.T_map_base).clearance;
     ArmGoalOutcome& outcome = outcomes_[static_cast<size_t>(current_)];
     outcome.min_clearance_m = outcome.min_clearance_m < 0.0 ? clearance : std::min(outcome.min_clearance_m, clearance);
   }

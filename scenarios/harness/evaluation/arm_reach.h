@@ -30,7 +30,7 @@ struct ArmReachPose {
 
 // The truth the arm works in: the garden objects near the robot as the simulator collides with
 // them, and the ground, in the map frame; `bush` indexes the bush's hull among them.
-struct ArmWorld {
+struct ArmCollisionTruth {
   robot::CollisionModel model;
   std::vector<int> bush;  // environment indices of the bush's hulls
   Eigen::Vector3d bush_centre = Eigen::Vector3d::Zero();
@@ -38,18 +38,19 @@ struct ArmWorld {
 };
 
 // Throws InputError naming the scenario when the bush is not a bush of the garden.
-ArmWorld MakeArmWorld(const Scenario& scenario, const sim::Simulator& simulator, const Eigen::Isometry3d& T_map_base);
+ArmCollisionTruth MakeArmCollisionTruth(const Scenario& scenario, const sim::Simulator& simulator,
+                                        const Eigen::Isometry3d& T_map_base);
 
 // `spec.poses` poses, drawn by rejection from uniformly random joint positions (the trial's seed);
 // throws InputError naming the scenario when too few are found (the bush out of the arm's reach).
-std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const ArmWorld& world,
+std::vector<ArmReachPose> GenerateArmReachPoses(const Scenario& scenario, const ArmCollisionTruth& truth,
                                                 const robot::RobotDescription& robot,
                                                 const Eigen::Isometry3d& T_map_base, std::uint64_t seed);
 
 class ArmReachEvaluator : public Observer {
  public:
   // `on_reached(goal)` is called when the stack reports a goal reached (for renders).
-  ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachPose> poses, ArmWorld* world,
+  ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachPose> poses, ArmCollisionTruth* truth,
                     std::function<void(int)> on_reached = {});
   void Observe(const StepView& step) override;
   // Fills the result's arm goals and counts, and success (all reached, no contact).
@@ -60,7 +61,7 @@ class ArmReachEvaluator : public Observer {
  private:
   ArmReach spec_;
   std::vector<ArmReachPose> poses_;
-  ArmWorld* world_;
+  ArmCollisionTruth* truth_;
   std::function<void(int)> on_reached_;
   std::vector<ArmGoalOutcome> outcomes_;
   std::set<std::pair<std::string, std::string>> touching_;  // arm contacts in the last step

@@ -74,10 +74,10 @@ bool Clear(const garden::Garden& garden, const Eigen::Vector2d& p) {
 
 std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptions& options, const ProjectPaths& paths,
                                                       const std::string& work_dir) {
-  WorldSetup world;
-  world.garden = options.garden;
-  world.seed = options.seed;
-  sim::SimulatorConfig config = MakeSimulatorConfig(paths, world, work_dir + "/world");
+  Setting setting;
+  setting.garden = options.garden;
+  setting.seed = options.seed;
+  sim::SimulatorConfig config = MakeSimulatorConfig(paths, setting, LoadGarden(setting, paths), work_dir + "/world");
   config.render_cameras = true;
   config.cameras_on_schedule = false;
   config.resolution_scale = kResolutionScale;
@@ -101,7 +101,7 @@ std::vector<RegistrationPair> RenderRegistrationPairs(const RegistrationSetOptio
     const double bearing = draws.Uniform(-M_PI, M_PI);
     const double turn_deg = draws.Uniform(options.min_turn_deg, options.max_turn_deg);
     const double turn = turn_deg * M_PI / 180.0 * (draws.Uniform(0.0, 1.0) < 0.5 ? -1.0 : 1.0);
-    std::array<sim::Pose2D, 2> views;
+    std::array<Pose2, 2> views;
     bool clear = true;
     for (int k = 0; k < 2; ++k) {
       const double b = bearing + k * turn;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "evaluation/registration_pair_file.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 

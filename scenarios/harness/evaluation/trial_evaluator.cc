@@ -16,12 +16,12 @@ namespace {
 
 constexpr double kEvaluationPeriod = 0.1;  // s: estimate errors and trajectories at 10 Hz
 
-void AddError(EstimateErrors& errors, double truth_x, double truth_y, double truth_yaw, const stack::Pose2& pose) {
+void AddError(EstimateErrors& errors, double truth_x, double truth_y, double truth_yaw, const Pose2& pose) {
   errors.position_m.push_back(std::hypot(pose.x - truth_x, pose.y - truth_y));
   errors.heading_deg.push_back(std::abs(AngleDifference(pose.yaw, truth_yaw)) * 180.0 / M_PI);
 }
 
-std::string Tum(double t, const stack::Pose2& pose) { return TumLine(t, stack::ToIsometry(pose)); }
+std::string Tum(double t, const Pose2& pose) { return TumLine(t, ToIsometry(pose)); }
 
 }  // namespace
 
@@ -48,8 +48,7 @@ TrialEvaluator::TrialEvaluator(const std::vector<GoalTruth>& goals, const GoalCr
 
 Eigen::Vector2d TrialEvaluator::TrueBushDistanceBearing(const PlanarPose& truth, int goal) const {
   const Eigen::Vector2d from_arm =
-      stack::IntoFrame({truth.x, truth.y, truth.yaw}, truths_[static_cast<std::size_t>(goal)].position) -
-      criteria_.arm_axis;
+      IntoFrame({truth.x, truth.y, truth.yaw}, truths_[static_cast<std::size_t>(goal)].position) - criteria_.arm_axis;
   return {from_arm.norm(), std::atan2(from_arm.y(), from_arm.x())};
 }
 
@@ -87,7 +86,7 @@ void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const Pl
 }
 
 TrialEvaluator::PlanarPose TrialEvaluator::Planar(double t, const Eigen::Isometry3d& pose) {
-  const stack::Pose2 planar = stack::ToPose2(pose);
+  const Pose2 planar = ToPose2(pose);
   return {t, planar.x, planar.y, planar.yaw};
 }
 
@@ -143,15 +142,15 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
   in_contact_ = contact;
 }
 
-void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const Eigen::Vector2d& outline_min,
+void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& true_map, const Eigen::Vector2d& outline_min,
                                       const Eigen::Vector2d& outline_max) {
   // Signed distance: in free cells to the nearest occupied one, in occupied cells minus the
   // distance to the nearest free one (cells outside the map: unknown).
-  cv::Mat free = world.occupied == 0, inside;
-  cv::distanceTransform(free, world_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::Mat free = true_map.occupied == 0, inside;
+  cv::distanceTransform(free, obstacle_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  world_distance_ = (world_distance_ - inside) * world.resolution;
-  world_ = world;
+  obstacle_distance_ = (obstacle_distance_ - inside) * true_map.resolution;
+  true_map_ = true_map;
   // The outline's perimeter every ~2 cm.
   outline_.clear();
   const Eigen::Vector2d corners[4] = {
@@ -164,16 +163,16 @@ void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& world, const E
 }
 
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
-  if (!world_distance_.empty()) {
+  if (!obstacle_distance_.empty()) {
     for (const Eigen::Vector2d& p : outline_) {
-      const cv::Point cell = world_.Cell(stack::FromFrame({truth.x, truth.y, truth.yaw}, p));
-      if (!cv::Rect(0, 0, world_distance_.cols, world_distance_.rows).contains(cell)) continue;
+      const cv::Point cell = true_map_.Cell(FromFrame({truth.x, truth.y, truth.yaw}, p));
+      if (!cv::Rect(0, 0, obstacle_distance_.cols, obstacle_distance_.rows).contains(cell)) continue;
       // The point is within half a cell of its cell's centre: count that against the robot.
-      min_clearance_ = std::min(min_clearance_, world_distance_.at<float>(cell) - 0.5 * world_.resolution);
+      min_clearance_ = std::min(min_clearance_, obstacle_distance_.at<float>(cell) - 0.5 * true_map_.resolution);
     }
   }
-  const stack::Pose2& estimate = step.telemetry->estimate.pose;
-  const stack::Pose2& odometry = step.telemetry->odometry;
+  const Pose2& estimate = step.telemetry->estimate.pose;
+  const Pose2& odometry = step.telemetry->odometry;
   sample_times_.push_back(step.time);
   AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
   AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);

@@ -17,7 +17,7 @@
 
 #include "evaluation/trial_result.h"
 #include "loop/closed_loop.h"
-#include "loop/trial_world.h"
+#include "loop/prepared_trial.h"
 #include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {
@@ -42,7 +42,7 @@ class TrialEvaluator : public Observer {
   // Also measure the smallest clearance between the robot's base outline (a rectangle in
   // base_link, RobotDescription::BaseOutline) at its true pose and the garden as it is (`world`);
   // negative: how deep the outline reaches into an obstacle's cells.
-  void MeasureClearance(const garden::OccupancyMap& world, const Eigen::Vector2d& outline_min,
+  void MeasureClearance(const garden::OccupancyMap& true_map, const Eigen::Vector2d& outline_min,
                         const Eigen::Vector2d& outline_max);
 
   // Completes `result` (status, goals, counts, errors) from what was observed; `finished`: the
@@ -89,8 +89,8 @@ class TrialEvaluator : public Observer {
   double timestep_ = 0.0;
   // Clearance: signed metres from each world cell to the nearest obstacle boundary (positive in
   // free space; empty: not measured), and points along the base's outline in base_link.
-  cv::Mat world_distance_;
-  garden::OccupancyMap world_;  // its cells
+  cv::Mat obstacle_distance_;
+  garden::OccupancyMap true_map_;  // its cells
   std::vector<Eigen::Vector2d> outline_;
   double min_clearance_ = std::numeric_limits<double>::infinity();
 };

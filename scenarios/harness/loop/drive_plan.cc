@@ -25,7 +25,7 @@ DrivePlan DrivePlan::Load(const std::string& path) {
   const YamlMap root = YamlMap::LoadFile(path);
   DrivePlan plan;
   plan.source = path;
-  plan.world = WorldSetup::Read(root, /*with_seed=*/true);
+  plan.setting = Setting::Read(root, /*with_seed=*/true);
   plan.save_every_frames = root.Has("save_every_frames") ? root.Integer("save_every_frames", 1, 1000000) : 10;
   for (const YamlMap& item : root.MapList("segments")) {
     DriveSegment segment;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 
@@ -21,7 +21,7 @@ struct DriveSegment {
 
 struct DrivePlan {
   std::string source;
-  WorldSetup world;
+  Setting setting;
   int save_every_frames = 10;
   std::vector<DriveSegment> segments;
 

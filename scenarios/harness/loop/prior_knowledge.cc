@@ -18,8 +18,8 @@ namespace trimbot::scenarios {
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
   garden::Garden surveyed = built;
   try {
-    garden::Garden world = built;  // checked here, before any trial: placed by the simulator
-    world.AddObjects(survey.unmapped_objects);
+    garden::Garden in_trials = built;  // checked here, before any trial: placed by the simulator
+    in_trials.AddObjects(survey.unmapped_objects);
   } catch (const std::invalid_argument& e) {
     throw InputError(scenario_file, std::string("survey.unmapped_objects: ") + e.what());
   }
@@ -95,10 +95,10 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
   return goals;
 }
 
-stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
+Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
   Rng rng = MakeRng(seed, "initial_pose");
   const double dx = StandardNormal(rng), dy = StandardNormal(rng), dyaw = StandardNormal(rng);
-  const sim::Pose2D& start = scenario.world.start;
+  const Pose2& start = scenario.setting.start;
   return {start.x + scenario.initial_position_sigma * dx, start.y + scenario.initial_position_sigma * dy,
           std::remainder(start.yaw + scenario.initial_yaw_sigma * dyaw, 2.0 * M_PI)};
 }

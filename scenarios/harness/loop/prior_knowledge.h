@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "loop/scenario.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/stack/robot_stack.h"
@@ -35,7 +35,7 @@ const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const S
                                    const std::string& what);
 
 // Where the operator believes the robot stands: the true start with seeded placement error.
-stack::Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed);
+Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed);
 
 // The camchain the stack reads: the true calibration, or with the scenario's seeded calibration
 // error written to <dir>/stack_camchain.yaml. Returns the file's path.

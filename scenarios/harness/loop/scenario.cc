@@ -257,7 +257,7 @@ Scenario Scenario::Load(const std::string& path, const std::vector<Override>& ov
   const YamlMap root(tree, overrides.empty() ? path : path + " (with --set)", "");
   s.name = root.String("name");
   s.description = root.String("description", "");
-  s.world = WorldSetup::Read(root, /*with_seed=*/true);
+  s.setting = Setting::Read(root, /*with_seed=*/true);
   ReadMission(root, s);
   s.trials = root.Has("trials") ? root.Integer("trials", 1, 100000) : 1;
   s.time_limit = root.NumberOr("time_limit", s.time_limit, 1e-3, 1e6, "s");

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "loop/map_recipe.h"
+#include "loop/setting.h"
 #include "loop/simulated_pose_fixes.h"
-#include "loop/world_setup.h"
 #include "trimbot/common/overrides.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/garden.h"
@@ -76,7 +76,7 @@ struct Scenario {
   std::string source;  // file it was read from
   std::string name;
   std::string description;
-  WorldSetup world;                   // world.seed is the batch seed; trial i runs with seed + i
+  Setting setting;                    // setting.seed is the batch seed; trial i runs with seed + i
   double map_resolution = 0.05;       // m: the robot's prior map, made from the surveyed garden
   double map_clearance_height = 1.0;  // m: objects whose lowest point is higher are not obstacles
   Survey survey;

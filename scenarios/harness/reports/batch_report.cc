@@ -143,14 +143,14 @@ Eigen::Vector2d MapSize(const garden::OccupancyMap& map) {
   return {map.occupied.cols * map.resolution, map.occupied.rows * map.resolution};
 }
 
-const cv::Scalar kNotInMap(215, 140, 70);  // orange (RGB, as every colour here): in the world, not in the map
+const cv::Scalar kNotInMap(215, 140, 70);  // orange (RGB, as every colour here): in the true_map, not in the map
 
-cv::Mat RenderMap(const garden::OccupancyMap& map, const garden::OccupancyMap& world, cv::Size size_px,
+cv::Mat RenderMap(const garden::OccupancyMap& map, const garden::OccupancyMap& true_map, cv::Size size_px,
                   const MapToImage& to_image) {
   const cv::Scalar kFree(248, 248, 244), kOccupied(90, 90, 90), kGridLine(222, 222, 218);
-  cv::Mat occupied, in_world;
+  cv::Mat occupied, in_garden;
   cv::resize(map.occupied, occupied, size_px, 0, 0, cv::INTER_NEAREST);
-  cv::resize(world.occupied, in_world, size_px, 0, 0, cv::INTER_NEAREST);
+  cv::resize(true_map.occupied, in_garden, size_px, 0, 0, cv::INTER_NEAREST);
   cv::Mat image(size_px, CV_8UC3, kFree);
   // 1 m grid, on free space only, to read distances anywhere on the map.
   const Eigen::Vector2d low = map.origin, high = map.origin + MapSize(map);
@@ -163,13 +163,13 @@ cv::Mat RenderMap(const garden::OccupancyMap& map, const garden::OccupancyMap& w
     cv::line(image, FixedPoint(to_image({low.x(), y}) + shift), FixedPoint(to_image({high.x(), y}) + shift), kGridLine,
              1, cv::LINE_8, kSubpixelBits);
   }
-  image.setTo(kNotInMap, in_world & ~occupied);
+  image.setTo(kNotInMap, in_garden & ~occupied);
   image.setTo(kOccupied, occupied);
   return image;
 }
 
-bool MapLacksSomething(const garden::OccupancyMap& map, const garden::OccupancyMap& world) {
-  return cv::countNonZero(world.occupied & ~map.occupied) > 0;
+bool MapLacksSomething(const garden::OccupancyMap& map, const garden::OccupancyMap& true_map) {
+  return cv::countNonZero(true_map.occupied & ~map.occupied) > 0;
 }
 
 int LegendHeight(std::size_t trajectories) {
@@ -399,7 +399,7 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary) {
   WriteFileAtomically(path, xml.str());
 }
 
-void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
+void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
                          const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
                          const std::string& title) {
   const Eigen::Vector2d map_size = MapSize(map);
@@ -418,10 +418,10 @@ void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& ma
   const int legend_top = kTitleBandHeight + map_px.height;
   cv::Mat image(legend_top + LegendHeight(trajectories.size()), kPlotWidth, CV_8UC3, kWhite);
   const cv::Rect map_area(cv::Point(static_cast<int>(to_image.offset.x), kTitleBandHeight), map_px);
-  if (world.occupied.size() != map.occupied.size()) {
-    throw std::invalid_argument(path + ": the world's map must have the prior map's cells");
+  if (true_map.occupied.size() != map.occupied.size()) {
+    throw std::invalid_argument(path + ": the true_map's map must have the prior map's cells");
   }
-  RenderMap(map, world, map_px, to_image).copyTo(image(map_area));
+  RenderMap(map, true_map, map_px, to_image).copyTo(image(map_area));
   cv::rectangle(image, map_area, cv::Scalar(150, 150, 150), 1);
   PutText(image, title, {kLegendMargin, 32}, 0.8, kInk, 2);
 
@@ -450,7 +450,7 @@ void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& ma
     DrawGoal(image, {static_cast<int>(std::lround(centre.x)), static_cast<int>(std::lround(centre.y))},
              static_cast<int>(g) + 1);
   }
-  DrawLegend(image, legend_top, trajectories, colours, to_image.pixels_per_metre, MapLacksSomething(map, world));
+  DrawLegend(image, legend_top, trajectories, colours, to_image.pixels_per_metre, MapLacksSomething(map, true_map));
   WritePng(path, image, true);
 }
 

@@ -21,7 +21,7 @@ struct PlotTrajectory {
 void WriteJunitXml(const std::string& path, const BatchSummary& summary);
 // `map`: the robot's prior map; `world`: the garden as it really is on the same cells (what the
 // map lacks is drawn in its own colour).
-void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& world,
+void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
                          const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
                          const std::string& title);
 // One panel per estimate name found in the trials (position error in centimetres).

@@ -53,7 +53,7 @@ void RunLog::LogSensors(const StepView& step) {
     std::snprintf(line, sizeof(line), "%.6f,%lld,%lld\n", t.stamp, static_cast<long long>(t.left),
                   static_cast<long long>(t.right));
     ticks_csv_ += line;
-    if (step.telemetry != nullptr) odometry_tum_ += TumLine(t.stamp, stack::ToIsometry(step.telemetry->odometry));
+    if (step.telemetry != nullptr) odometry_tum_ += TumLine(t.stamp, ToIsometry(step.telemetry->odometry));
   }
 }
 

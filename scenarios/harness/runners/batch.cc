@@ -193,7 +193,7 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
 // `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
 // `final_out`: the folder the log names (merge builds the reports beside it and swaps them in).
 int WriteReports(const std::string& out, const std::string& final_out, const Scenario& scenario,
-                 const garden::OccupancyMap& map, const garden::OccupancyMap& world,
+                 const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
                  const std::vector<Eigen::Vector2d>& goals, const BatchInfo& info, std::vector<TrialResult> results,
                  int trials_planned, std::ostream& log) {
   std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
@@ -232,7 +232,7 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
           {r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
     }
     WriteTrajectoryPlot(
-        out + "/trajectories.png", map, world, trajectories, goals,
+        out + "/trajectories.png", map, true_map, trajectories, goals,
         scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
     WriteErrorHistograms(out + "/localization_errors.png", results,
                          scenario.name + ": localization error against ground truth");
@@ -316,7 +316,7 @@ std::vector<int> ShardTrials(const BatchInfo& info) {
   return trials;
 }
 
-RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, const TrialWorld& world,
+RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, const PreparedTrial& prepared,
                         const BatchInfo& info, int index) {
   RunningTrial trial;
   trial.index = index;
@@ -324,8 +324,8 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
   trial.dir = TrialDir(options.out_dir, index);
   fs::remove_all(trial.dir);
   fs::create_directories(trial.dir);
-  const TrialSetup setup{&scenario, &world, options.paths, options.out_dir + "/map/map.yaml",
-                         trial.dir, index,  trial.seed};
+  const TrialSetup setup{&scenario, &prepared, options.paths, options.out_dir + "/map/map.yaml",
+                         trial.dir, index,     trial.seed};
   std::cout.flush();
   trial.started = Clock::now();
   trial.pid = fork();
@@ -389,19 +389,19 @@ void PrintProgress(const std::vector<RunningTrial>& running, std::size_t done, i
 
 BatchInputs LoadBatchInputs(const BatchOptions& options) {
   Scenario scenario = Scenario::Load(options.scenario_path, ParseOverrides(options.overrides));
-  TrialWorld world = PrepareTrialWorld(scenario, options.paths);
-  return {std::move(scenario), std::move(world)};
+  PreparedTrial prepared = PrepareTrial(scenario, options.paths);
+  return {std::move(scenario), std::move(prepared)};
 }
 
 int RunBatch(const BatchOptions& options) {
   // Every input is read and checked before the output folder is touched.
   BatchInputs inputs = LoadBatchInputs(options);
   Scenario& scenario = inputs.scenario;
-  const TrialWorld& world = inputs.world;
+  const PreparedTrial& prepared = inputs.prepared;
   const std::string& out = options.out_dir;
   BatchInfo info;
   info.scenario_file = fs::absolute(options.scenario_path).string();
-  info.seed = options.seed.value_or(scenario.world.seed);
+  info.seed = options.seed.value_or(scenario.setting.seed);
   info.trials = options.trials.value_or(scenario.trials);
   info.shard_index = options.shard_index;
   info.shard_count = options.shard_count;
@@ -417,7 +417,7 @@ int RunBatch(const BatchOptions& options) {
   fs::create_directories(out);
   WriteFileAtomically(out + "/batch.json", ToJson(info).dump(2));
   WriteFileAtomically(out + "/scenario.yaml", scenario.effective_yaml);
-  WritePriorMap(world.prior_map, out + "/map");
+  WritePriorMap(prepared.prior_map, out + "/map");
 
   std::vector<int> queue = ShardTrials(info);
   const int planned = static_cast<int>(queue.size());
@@ -445,12 +445,12 @@ int RunBatch(const BatchOptions& options) {
   std::vector<TrialResult> results;
   while (!queue.empty() || !running.empty()) {
     while (static_cast<int>(running.size()) < options.jobs && !queue.empty()) {
-      running.push_back(StartTrial(options, scenario, world, info, queue.back()));
+      running.push_back(StartTrial(options, scenario, prepared, info, queue.back()));
       queue.pop_back();
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     for (auto it = running.begin(); it != running.end();) {
-      std::optional<TrialResult> result = PollTrial(*it, scenario, world.goal_truths);
+      std::optional<TrialResult> result = PollTrial(*it, scenario, prepared.goal_truths);
       if (!result) {
         ++it;
         continue;
@@ -464,8 +464,8 @@ int RunBatch(const BatchOptions& options) {
     }
     if (interactive && !running.empty()) PrintProgress(running, results.size(), planned, scenario, batch_start);
   }
-  return WriteReports(out, out, scenario, world.prior_map, world.true_map, GoalPositions(world.mission), info, results,
-                      planned, log);
+  return WriteReports(out, out, scenario, prepared.prior_map, prepared.true_map, GoalPositions(prepared.mission), info,
+                      results, planned, log);
 }
 
 // `staged` becomes `target`: the folder it replaces is removed only once the new one is in place.
@@ -534,11 +534,11 @@ int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& o
               << " trials have no result in the shards; they count as failed\n";
   }
   const Scenario scenario = Scenario::Load(staging + "/scenario.yaml");
-  const TrialWorld world = PrepareTrialWorld(scenario, paths);
+  const PreparedTrial prepared = PrepareTrial(scenario, paths);
   std::ostream null_log(nullptr);  // writes nothing
   const int exit_code =
-      WriteReports(staging, out_dir, scenario, world.prior_map, world.true_map, GoalPositions(world.mission), merged,
-                   found, merged.trials, quiet ? null_log : std::cout);
+      WriteReports(staging, out_dir, scenario, prepared.prior_map, prepared.true_map, GoalPositions(prepared.mission),
+                   merged, found, merged.trials, quiet ? null_log : std::cout);
   ReplaceFolder(staging, out_dir);
   return exit_code;
 }

@@ -21,9 +21,9 @@
 #include <thread>
 #include <vector>
 
+#include "loop/prepared_trial.h"
 #include "loop/scenario.h"
-#include "loop/trial_world.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 
@@ -38,7 +38,7 @@ struct BatchOptions {
   std::optional<std::uint64_t> seed;  // overrides the scenario's
   int jobs = DefaultJobs();
   int shard_index = 0, shard_count = 1;
-  bool keep_worlds = false;            // keep each trial's composed MuJoCo world (large textures)
+  bool keep_worlds = false;            // keep each trial's composed MuJoCo prepared (large textures)
   std::vector<std::string> overrides;  // --set key.path=value, applied to the scenario file
   bool quiet = false;                  // no per-trial lines or report listing (sweeps, tuning)
 };
@@ -52,11 +52,11 @@ int RunBatch(const BatchOptions& options);
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir,
                 const ProjectPaths& paths = ProjectPaths::Default(), bool quiet = false);
 
-// What a batch is run from: its scenario with its overrides and its trial world, read and checked
+// What a batch is run from: its scenario with its overrides and its prepared trial, read and checked
 // before anything is written. Throws InputError naming the file and key.
 struct BatchInputs {
   Scenario scenario;
-  TrialWorld world;
+  PreparedTrial prepared;
 };
 BatchInputs LoadBatchInputs(const BatchOptions& options);
 

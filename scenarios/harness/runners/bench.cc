@@ -27,12 +27,13 @@ double Seconds(Clock::time_point since) { return std::chrono::duration<double>(C
 
 sim::SimulatorConfig Config(const BenchOptions& options, bool cameras, double scale, int msaa = 4, bool shadows = true,
                             bool culling = true) {
-  WorldSetup world;
-  world.garden = options.garden;
-  world.seed = 7;
-  world.conditions.shadows = shadows;
-  sim::SimulatorConfig config = MakeSimulatorConfig(
-      options.paths, world, std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
+  Setting setting;
+  setting.garden = options.garden;
+  setting.seed = 7;
+  setting.conditions.shadows = shadows;
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(options.paths, setting, LoadGarden(setting, options.paths),
+                          std::filesystem::temp_directory_path().string() + "/trimbot_bench_world");
   config.render_cameras = cameras;
   config.resolution_scale = scale;
   config.msaa_samples = msaa;

@@ -1,7 +1,7 @@
 #pragma once
 #include <string>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 

@@ -23,9 +23,10 @@ namespace fs = std::filesystem;
 
 using Clock = std::chrono::steady_clock;
 
-sim::SimulatorConfig PlantFor(const DriveOptions& options, const DrivePlan& plan, WorldSetup world) {
-  if (options.seed) world.seed = *options.seed;
-  sim::SimulatorConfig config = MakeSimulatorConfig(options.paths, world, options.output_dir + "/world");
+sim::SimulatorConfig PlantFor(const DriveOptions& options, const DrivePlan& plan, Setting setting) {
+  if (options.seed) setting.seed = *options.seed;
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(options.paths, setting, LoadGarden(setting, options.paths), options.output_dir + "/world");
   if (!options.calibration_path.empty()) config.robot.camchain = options.calibration_path;
   config.render_cameras = options.cameras;
   config.ground_truth_every_frames = plan.save_every_frames;
@@ -57,16 +58,16 @@ class ProgressLine : public Observer {
 nlohmann::json Summary(const DriveOptions& options, const DrivePlan& plan, const sim::SimulatorConfig& config,
                        const sim::Simulator& simulator, const RunLog& log, const stack::Telemetry& telemetry) {
   const sim::GroundTruth truth = simulator.ground_truth();
-  const stack::Pose2& odometry = telemetry.odometry;
+  const Pose2& odometry = telemetry.odometry;
   const Eigen::Vector3d end = truth.T_map_base.translation();
   nlohmann::json summary;
   summary["plan"] = options.plan_path;
-  summary["garden"] = config.garden_path;
+  summary["garden"] = config.garden.source;
   summary["seed"] = config.seed;
-  summary["conditions"] = {{"time_of_day", plan.world.conditions.time_of_day},
-                           {"day_of_year", plan.world.conditions.day_of_year},
-                           {"shadows", plan.world.conditions.shadows},
-                           {"growth", plan.world.conditions.growth}};
+  summary["conditions"] = {{"time_of_day", plan.setting.conditions.time_of_day},
+                           {"day_of_year", plan.setting.conditions.day_of_year},
+                           {"shadows", plan.setting.conditions.shadows},
+                           {"growth", plan.setting.conditions.growth}};
   summary["calibration"] = config.robot.camchain;
   summary["simulated_seconds"] = simulator.time();
   summary["physics_timestep"] = simulator.timestep();
@@ -85,8 +86,7 @@ nlohmann::json Summary(const DriveOptions& options, const DrivePlan& plan, const
 int RunDrive(const DriveOptions& options) {
   // The inputs are read and checked before the output folder is touched.
   const DrivePlan plan = DrivePlan::Load(options.plan_path);
-  const sim::SimulatorConfig config = PlantFor(options, plan, plan.world);
-  garden::Garden::Load(config.garden_path);
+  const sim::SimulatorConfig config = PlantFor(options, plan, plan.setting);
   const stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
   const std::string out = options.output_dir;
   fs::create_directories(out);
@@ -96,7 +96,7 @@ int RunDrive(const DriveOptions& options) {
 
   // The stack listens (wheel odometry, EKF) from the plan's start; the plan drives.
   stack::RobotStack listener(options.paths.robot_files(), parameters, config.seed);
-  listener.SetInitialPose(0.0, {plan.world.start.x, plan.world.start.y, plan.world.start.yaw});
+  listener.SetInitialPose(0.0, plan.setting.start);
   const double duration = std::min(plan.duration(), options.seconds.value_or(plan.duration()));
   DrivePlanPlayer player(plan, duration, &listener);
   RunLog log(out, plan.save_every_frames);

@@ -3,7 +3,7 @@
 #include <optional>
 #include <string>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 

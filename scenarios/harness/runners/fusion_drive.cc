@@ -9,7 +9,7 @@
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
 #include "loop/pilots.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/sim/simulator.h"
@@ -44,8 +44,8 @@ class PairPrinter : public Observer {
 int RunFusionDrive(const FusionDriveOptions& options, const ProjectPaths& paths) {
   // The inputs are read and checked before the output folder is touched.
   const DrivePlan plan = DrivePlan::Load(options.plan);
-  sim::SimulatorConfig config = MakeSimulatorConfig(paths, plan.world, options.out + "/world");
-  garden::Garden::Load(config.garden_path);
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(paths, plan.setting, LoadGarden(plan.setting, paths), options.out + "/world");
   stack::StackParameters parameters = stack::StackParameters::Load(paths.robot_files().stack_parameters);
   std::filesystem::create_directories(options.out);
   config.cameras_on_schedule = false;  // only the frames the stack's local fusion wants are rendered
@@ -54,7 +54,7 @@ int RunFusionDrive(const FusionDriveOptions& options, const ProjectPaths& paths)
   // The stack listens with local fusion on; the plan drives.
   parameters.local_fusion = options.fusion;
   stack::RobotStack listener(paths.robot_files(), parameters, config.seed);
-  listener.SetInitialPose(0.0, {plan.world.start.x, plan.world.start.y, plan.world.start.yaw});
+  listener.SetInitialPose(0.0, plan.setting.start);
   // Enough drive for the clouds asked for (one more frame than registrations), within the plan.
   const double duration = std::min(plan.duration(), options.fusion.interval * options.clouds + 0.5);
   DrivePlanPlayer player(plan, duration, &listener);

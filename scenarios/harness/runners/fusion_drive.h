@@ -5,7 +5,7 @@
 // (reference deliverable D3.4, Figures 25/26: translation 11.4 -> 5.8 cm, rotation 1.08 -> 1.46 deg).
 #include <string>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/stack/stack_parameters.h"  // perception::LocalFusionOptions
 
 namespace trimbot::scenarios {

@@ -3,7 +3,7 @@
 // exported as an occupancy map and a ground-truth point cloud.
 #include <string>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/garden/garden_tools.h"
 
 namespace trimbot::scenarios {

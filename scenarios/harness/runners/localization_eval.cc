@@ -38,7 +38,7 @@ struct QueryFrame {
 };
 
 struct QueryDrive {
-  WorldSetup world;
+  Setting setting;
   std::vector<QueryFrame> frames;
 };
 
@@ -63,14 +63,15 @@ class QueryRecorder : public Observer {
 QueryDrive RenderQueryDrive(const QueryDriveOptions& options, const ProjectPaths& paths, const std::string& work_dir) {
   const DrivePlan plan = DrivePlan::Load(options.plan_path);
   QueryDrive drive;
-  drive.world = plan.world;
-  drive.world.seed = options.seed.value_or(plan.world.seed + kQuerySeedOffset);
-  if (options.time_of_day) drive.world.conditions.time_of_day = *options.time_of_day;
-  if (options.day_of_year) drive.world.conditions.day_of_year = *options.day_of_year;
-  if (options.growth) drive.world.conditions.growth = *options.growth;
-  drive.world.start.x -= options.lateral_offset * std::sin(drive.world.start.yaw);
-  drive.world.start.y += options.lateral_offset * std::cos(drive.world.start.yaw);
-  sim::SimulatorConfig config = MakeSimulatorConfig(paths, drive.world, work_dir + "/world");
+  drive.setting = plan.setting;
+  drive.setting.seed = options.seed.value_or(plan.setting.seed + kQuerySeedOffset);
+  if (options.time_of_day) drive.setting.conditions.time_of_day = *options.time_of_day;
+  if (options.day_of_year) drive.setting.conditions.day_of_year = *options.day_of_year;
+  if (options.growth) drive.setting.conditions.growth = *options.growth;
+  drive.setting.start.x -= options.lateral_offset * std::sin(drive.setting.start.yaw);
+  drive.setting.start.y += options.lateral_offset * std::cos(drive.setting.start.yaw);
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(paths, drive.setting, LoadGarden(drive.setting, paths), work_dir + "/world");
   config.render_cameras = true;
   config.cameras_on_schedule = false;
   config.resolution_scale = *options.resolution_scale;
@@ -84,8 +85,9 @@ QueryDrive RenderQueryDrive(const QueryDriveOptions& options, const ProjectPaths
   loop.render_on_demand = true;
   loop.ring_demand = [&](const sim::GroundTruth& truth) { return recorder.Wants(truth.stamp); };
   std::cout << "[query] rendering ring frames every " << options.interval << " s along " << options.plan_path
-            << " (seed " << drive.world.seed << ", " << drive.world.conditions.time_of_day << " h, day "
-            << drive.world.conditions.day_of_year << ", growth " << drive.world.conditions.growth << ")" << std::endl;
+            << " (seed " << drive.setting.seed << ", " << drive.setting.conditions.time_of_day << " h, day "
+            << drive.setting.conditions.day_of_year << ", growth " << drive.setting.conditions.growth << ")"
+            << std::endl;
   RunClosedLoop(simulator, player, {&recorder}, loop);
   drive.frames = std::move(recorder.frames());
   return drive;
@@ -123,10 +125,10 @@ nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriv
                          const QueryDrive& drive) {
   return {{"map", options.map_path},
           {"plan", query.plan_path},
-          {"seed", drive.world.seed},
-          {"time_of_day", drive.world.conditions.time_of_day},
-          {"day_of_year", drive.world.conditions.day_of_year},
-          {"growth", drive.world.conditions.growth},
+          {"seed", drive.setting.seed},
+          {"time_of_day", drive.setting.conditions.time_of_day},
+          {"day_of_year", drive.setting.conditions.day_of_year},
+          {"growth", drive.setting.conditions.growth},
           {"lateral_offset_m", query.lateral_offset},
           {"resolution_scale", *query.resolution_scale},
           {"msaa_samples", query.msaa_samples},
@@ -142,7 +144,7 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
   QueryDriveOptions query;
   const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
   const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
-  NoisyPrior prior(drive.world.seed, options.prior_sigma);
+  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
   std::vector<visual_localization::LocalizationTimings> timings;
   std::vector<double> position_errors, heading_errors;
   int fixes = 0, within_25cm = 0;
@@ -159,9 +161,8 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
     ++fixes;
     const double error = (result.T_map_base.translation() - query.T_map_base.translation()).head<2>().norm();
     position_errors.push_back(error);
-    heading_errors.push_back(
-        std::abs(AngleDifference(stack::ToPose2(result.T_map_base).yaw, stack::ToPose2(query.T_map_base).yaw)) * 180.0 /
-        M_PI);
+    heading_errors.push_back(std::abs(AngleDifference(ToPose2(result.T_map_base).yaw, ToPose2(query.T_map_base).yaw)) *
+                             180.0 / M_PI);
     within_25cm += error <= 0.25 ? 1 : 0;
   }
   const double n = std::max<double>(1, drive.frames.size());
@@ -206,7 +207,7 @@ int RunRetrievalEval(const LocalizationEvalOptions& options) {
   QueryDriveOptions query;
   const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
   const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
-  NoisyPrior prior(drive.world.seed, options.prior_sigma);
+  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
   constexpr std::array<int, 3> kThresholds = {50, 100, 200};
   const std::array<std::pair<Retrieval, const char*>, 3> methods = {{{Retrieval::kVocabulary, "vocabulary"},
                                                                      {Retrieval::kPosePrior, "pose_prior"},

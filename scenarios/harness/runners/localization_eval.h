@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 

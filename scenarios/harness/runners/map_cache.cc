@@ -157,14 +157,14 @@ std::string DefaultMapCacheDir() {
 std::string MapCacheKey(const MapRecipe& recipe, const ProjectPaths& paths) {
   if (!recipe.descriptor) throw std::logic_error("MapCacheKey: the recipe's descriptor is not set");
   const YamlMap plan = YamlMap::LoadFile(recipe.plan_path);
-  const WorldSetup world = WorldSetup::Read(plan, /*with_seed=*/false);
+  const Setting setting = Setting::Read(plan, /*with_seed=*/false);
   const robot::RobotFiles robot = paths.robot_files();
   std::ostringstream key;
   key << "trimbot visual map cache key 1\n"
       << "map format version " << visual_localization::kMapFormatVersion << "\n"
       << "garden appearance version " << garden::kTextureGeneratorVersion << "\n"
       << "mapping drive " << Hex(Fnv1a(YamlContent(recipe.plan_path))) << "\n"
-      << "garden " << Hex(Fnv1a(YamlContent(ResolveGarden(world, paths)))) << "\n"
+      << "garden " << Hex(Fnv1a(YamlContent(ResolveGarden(setting, paths)))) << "\n"
       << "urdf " << Hex(Fnv1a(ReadBytes(robot.urdf))) << "\n"
       << "camchain " << Hex(Fnv1a(YamlContent(robot.camchain))) << "\n"
       << "robot parameters " << Hex(Fnv1a(YamlContent(robot.robot_parameters))) << "\n";

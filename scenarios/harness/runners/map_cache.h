@@ -20,7 +20,7 @@
 #include <string>
 
 #include "loop/scenario.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "runners/mapping.h"
 
 namespace trimbot::scenarios {

@@ -90,7 +90,7 @@ constexpr std::uint64_t kMappingSeedOffset = 1000;  // a scenario's mapping driv
 // The mapping drive: a drive plan played open loop, or a scenario whose goals the robot drives to
 // with its stack (navigating on the simulated fixes, or dead reckoning: the map does not exist yet).
 struct MappingDrive {
-  WorldSetup world;
+  Setting setting;
   double duration = 0.0;
   std::optional<DrivePlan> plan;
   std::optional<Scenario> scenario;
@@ -106,30 +106,30 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   drive->descriptor = parameters.visual.descriptor;
   if (!YamlMap::LoadFile(options.recipe.plan_path).Has("goals")) {
     drive->plan = DrivePlan::Load(options.recipe.plan_path);
-    drive->world = drive->plan->world;
-    if (options.recipe.seed) drive->world.seed = *options.recipe.seed;
+    drive->setting = drive->plan->setting;
+    if (options.recipe.seed) drive->setting.seed = *options.recipe.seed;
     drive->duration = std::min(drive->plan->duration(), options.recipe.seconds.value_or(drive->plan->duration()));
     drive->pilot = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
     return drive;
   }
   drive->scenario = Scenario::Load(options.recipe.plan_path);
   const Scenario& scenario = *drive->scenario;
-  drive->world = scenario.world;
-  drive->world.seed = options.recipe.seed.value_or(scenario.world.seed + kMappingSeedOffset);
+  drive->setting = scenario.setting;
+  drive->setting.seed = options.recipe.seed.value_or(scenario.setting.seed + kMappingSeedOffset);
   drive->duration = std::min(scenario.time_limit, options.recipe.seconds.value_or(scenario.time_limit));
   if (scenario.stack) parameters = parameters.Overridden(*scenario.stack);
   drive->descriptor = parameters.visual.descriptor;
   if (parameters.localization == stack::LocalizationSource::kVisual) {
     parameters.localization = stack::LocalizationSource::kSimulatedPoseFixes;
   }
-  drive->robot = std::make_unique<stack::RobotStack>(options.paths.robot_files(), parameters, drive->world.seed);
-  drive->robot->SetInitialPose(0.0, {scenario.world.start.x, scenario.world.start.y, scenario.world.start.yaw});
-  const garden::Garden surveyed = SurveyedGarden(garden::Garden::Load(ResolveGarden(scenario.world, options.paths)),
-                                                 scenario.survey, scenario.source);
+  drive->robot = std::make_unique<stack::RobotStack>(options.paths.robot_files(), parameters, drive->setting.seed);
+  drive->robot->SetInitialPose(0.0, scenario.setting.start);
+  const garden::Garden surveyed =
+      SurveyedGarden(LoadGarden(scenario.setting, options.paths), scenario.survey, scenario.source);
   drive->robot->SetMap(WritePriorMap(PriorMap(scenario, surveyed), options.out_dir + "/prior_map"));
   drive->robot->SetGoals(MissionGoals(scenario, surveyed));
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
-    drive->fixes.emplace(scenario.simulated_pose_fixes, drive->world.seed);
+    drive->fixes.emplace(scenario.simulated_pose_fixes, drive->setting.seed);
   }
   drive->pilot = std::make_unique<StackPilot>(*drive->robot);
   return drive;
@@ -150,8 +150,9 @@ int RunMapBuild(const MapBuildOptions& options) {
   const auto wall_start = Clock::now();
   std::filesystem::create_directories(options.out_dir);
   const std::unique_ptr<MappingDrive> drive = LoadMappingDrive(options);
-  const WorldSetup& world = drive->world;
-  sim::SimulatorConfig config = MakeSimulatorConfig(options.paths, world, options.out_dir + "/world");
+  const Setting& setting = drive->setting;
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(options.paths, setting, LoadGarden(setting, options.paths), options.out_dir + "/world");
   config.cameras_on_schedule = false;  // only the keyframes are rendered
   sim::Simulator simulator(config);
 
@@ -160,7 +161,7 @@ int RunMapBuild(const MapBuildOptions& options) {
   const visual_localization::MapBuilderOptions builder_options =
       MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(drive->descriptor));
   visual_localization::MapBuilder builder(rig, builder_options);
-  SurveyPoses survey(world.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
+  SurveyPoses survey(setting.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
 
   MapRecorder recorder(builder, survey);
   LoopOptions loop;
@@ -197,7 +198,7 @@ int RunMapBuild(const MapBuildOptions& options) {
   const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   nlohmann::json report = {{"plan", options.recipe.plan_path},
                            {"garden", map.garden},
-                           {"seed", world.seed},
+                           {"seed", setting.seed},
                            {"descriptor", visual_localization::ToString(map.descriptor)},
                            {"frames_seen", stats.frames},
                            {"keyframes", stats.keyframes},

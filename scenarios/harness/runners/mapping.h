@@ -13,7 +13,7 @@
 #include <string>
 
 #include "loop/map_recipe.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/visual_localization/features.h"
 #include "trimbot/visual_localization/map_builder.h"
 

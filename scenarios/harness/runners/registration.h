@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "evaluation/registration_set.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/perception/registration.h"
 
 namespace trimbot::scenarios {

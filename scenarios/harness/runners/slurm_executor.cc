@@ -198,7 +198,7 @@ std::vector<Task> PlanTasks(const std::vector<BatchOptions>& batches, const std:
   for (std::size_t b = 0; b < batches.size(); ++b) {
     const BatchOptions& batch = batches[b];
     const int trials = batch.trials.value_or(scenarios[b].trials);
-    const std::uint64_t seed = batch.seed.value_or(scenarios[b].world.seed);
+    const std::uint64_t seed = batch.seed.value_or(scenarios[b].setting.seed);
     const int shards = (trials + options.trials_per_task - 1) / options.trials_per_task;
     for (int shard = 0; shard < shards; ++shard) {
       Task task;

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "evaluation/stereo_evaluation.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/perception/stereo.h"
 #include "trimbot/sim/simulator.h"
@@ -70,11 +70,12 @@ void WriteCloudPly(const std::string& path, const perception::PointCloud& cloud)
 
 int RunStereoFrame(const StereoFrameOptions& options, const ProjectPaths& paths) {
   namespace fs = std::filesystem;
-  WorldSetup world;
-  world.garden = options.garden;
-  world.seed = options.seed;
-  world.start = {options.x, options.y, options.yaw_degrees * M_PI / 180.0};
-  sim::SimulatorConfig config = MakeSimulatorConfig(paths, world, options.output + "/world");
+  Setting setting;
+  setting.garden = options.garden;
+  setting.seed = options.seed;
+  setting.start = {options.x, options.y, options.yaw_degrees * M_PI / 180.0};
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(paths, setting, LoadGarden(setting, paths), options.output + "/world");
   fs::create_directories(options.output);
   sim::Simulator simulator(config);
   const sim::RingCapture capture = simulator.CaptureRing(true);

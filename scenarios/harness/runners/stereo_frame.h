@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "runners/batch_executor.h"
 
 namespace trimbot::scenarios {

@@ -33,9 +33,9 @@ void WriteCostmapImage(const std::string& path, const cv::Mat& layers) {
 // `render_for_stack`: the stack asks for the ring cameras it uses, when it uses them.
 sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   const Scenario& scenario = *setup.scenario;
-  WorldSetup world = scenario.world;
-  world.seed = setup.seed;
-  sim::SimulatorConfig config = MakeSimulatorConfig(setup.paths, world, setup.dir + "/world");
+  Setting setting = scenario.setting;
+  setting.seed = setup.seed;
+  sim::SimulatorConfig config = MakeSimulatorConfig(setup.paths, setting, setup.prepared->garden, setup.dir + "/world");
   config.render_cameras = scenario.render_cameras || render_for_stack;
   config.cameras_on_schedule = !render_for_stack;
   config.resolution_scale = scenario.resolution_scale;
@@ -69,12 +69,12 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   result.seed = setup.seed;
   robot::RobotFiles files = setup.paths.robot_files();
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
-  const stack::StackParameters& parameters = setup.world->stack_parameters;
+  const stack::StackParameters& parameters = setup.prepared->stack_parameters;
   sim::Simulator simulator(PlantFor(setup, /*render_for_stack=*/true));
   const Eigen::Isometry3d T_map_base = simulator.ground_truth().T_map_base;
-  ArmWorld world = MakeArmWorld(scenario, simulator, T_map_base);
+  ArmCollisionTruth truth = MakeArmCollisionTruth(scenario, simulator, T_map_base);
   const std::vector<ArmReachPose> poses =
-      GenerateArmReachPoses(scenario, world, simulator.robot(), T_map_base, setup.seed);
+      GenerateArmReachPoses(scenario, truth, simulator.robot(), T_map_base, setup.seed);
 
   stack::RobotStack robot(files, parameters, setup.seed);
   robot.SetInitialPose(0.0, BelievedStart(scenario, setup.seed));
@@ -83,17 +83,17 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   robot.SetArmGoals(goals);
   // A view across the robot and the bush at the first poses reached.
   int rendered = 0;
-  const Eigen::Vector3d across = world.bush_centre - T_map_base.translation();
+  const Eigen::Vector3d across = truth.bush_centre - T_map_base.translation();
   const double view_azimuth = std::atan2(across.y(), across.x()) * 180.0 / M_PI + 90.0;
   const auto render = [&](int goal) {
     if (rendered >= spec.renders) return;
     ++rendered;
-    const Eigen::Vector3d lookat = 0.5 * (T_map_base.translation() + world.bush_centre) + Eigen::Vector3d(0, 0, 0.3);
+    const Eigen::Vector3d lookat = 0.5 * (T_map_base.translation() + truth.bush_centre) + Eigen::Vector3d(0, 0, 0.3);
     char name[32];
     std::snprintf(name, sizeof(name), "/arm_pose_%02d.png", goal);
     WritePng(setup.dir + name, simulator.RenderExternalView(lookat, 2.6, view_azimuth, -20.0, 800, 600), true);
   };
-  ArmReachEvaluator evaluator(spec, poses, &world, render);
+  ArmReachEvaluator evaluator(spec, poses, &truth, render);
   StackPilot pilot(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;
@@ -136,9 +136,9 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   // The robot's side, from its own files and what the operator knows; never from the simulator.
   robot::RobotFiles files = setup.paths.robot_files();
   files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
-  const stack::StackParameters& parameters = setup.world->stack_parameters;
+  const stack::StackParameters& parameters = setup.prepared->stack_parameters;
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
-  const std::vector<stack::Goal>& mission = setup.world->mission;
+  const std::vector<stack::Goal>& mission = setup.prepared->mission;
   const bool uses_images = stack::RobotStack::UsesRingImages(parameters, mission);
   sim::Simulator simulator(PlantFor(setup, uses_images));
   stack::RobotStack robot(files, parameters, setup.seed);
@@ -156,10 +156,10 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   criteria.bush_distance = scenario.bush_distance_tolerance;
   criteria.bush_bearing = scenario.bush_bearing_tolerance;
   criteria.arm_axis = simulator.robot().FramePose(robot::RobotFrames::kCameraRing).translation().head<2>();
-  TrialEvaluator evaluator(setup.world->goal_truths, criteria,
+  TrialEvaluator evaluator(setup.prepared->goal_truths, criteria,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
   const auto [outline_min, outline_max] = simulator.robot().BaseOutline();
-  evaluator.MeasureClearance(setup.world->true_map, outline_min, outline_max);
+  evaluator.MeasureClearance(setup.prepared->true_map, outline_min, outline_max);
   StackPilot pilot(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;

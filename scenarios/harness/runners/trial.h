@@ -10,15 +10,15 @@
 #include <string>
 
 #include "evaluation/trial_result.h"
+#include "loop/prepared_trial.h"
 #include "loop/scenario.h"
-#include "loop/trial_world.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 
 namespace trimbot::scenarios {
 
 struct TrialSetup {
   const Scenario* scenario = nullptr;
-  const TrialWorld* world = nullptr;  // the scenario's, prepared once for the batch
+  const PreparedTrial* prepared = nullptr;  // the scenario's, prepared once for the batch
   ProjectPaths paths;
   std::string map_yaml;  // the robot's prior map (map_server YAML)
   std::string dir;       // this trial's output folder

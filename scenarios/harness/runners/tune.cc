@@ -208,7 +208,7 @@ int RunTune(const TuneOptions& options) {
 
   // The honest figure: the best point and the scenario as it is, both on fresh seeds.
   const Evaluation best = search.Best();
-  const std::uint64_t fresh = options.seed.value_or(scenario.world.seed) + kFreshSeedOffset;
+  const std::uint64_t fresh = options.seed.value_or(scenario.setting.seed) + kFreshSeedOffset;
   json best_summary, default_summary;
   const double best_fresh = search.RunPoint(best.overrides, options.out_dir + "/fresh/best", fresh, &best_summary);
   const double default_fresh = search.RunPoint({}, options.out_dir + "/fresh/default", fresh, &default_summary);

@@ -9,15 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/garden/object_class.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
 
 namespace trimbot::sim {
-
-struct Pose2D {
-  double x = 0.0, y = 0.0, yaw = 0.0;
-};
 
 // What the label images report for a geom.
 struct GeomLabel {
@@ -29,7 +26,7 @@ struct GeomLabel {
 };
 
 struct RobotMjcfOptions {
-  Pose2D start;                      // base_link in the world (the free joint's initial pose)
+  Pose2 start;                       // base_link in the world (the free joint's initial pose)
   double render_oversampling = 1.0;  // the cameras' field of view covers RenderPinholeFor's render
 };
 

@@ -34,14 +34,14 @@ class World;
 
 struct SimulatorConfig {
   robot::RobotFiles robot;  // urdf, camchain (the cameras as they really are), parameters
-  std::string garden_path;
+  garden::Garden garden;    // as built (read once by the caller); its source names it in errors
   // Objects placed in the world beyond the garden file's (a scenario's obstacles the survey never
   // saw); their ids must not be the garden's.
   std::vector<garden::GardenObject> extra_objects;
   std::string world_dir;  // where world.xml and its textures are written
   std::uint64_t seed = 0;
   garden::Conditions conditions;  // time of day, shadows, growth
-  Pose2D start;
+  Pose2 start;
   double timestep = 0.0025;  // s
   bool render_cameras = true;
   bool cameras_on_schedule = true;    // false: the ring renders only when CaptureRing is called
@@ -168,7 +168,7 @@ class Simulator {
   RingCapture CaptureRing(const messages::RingRequest& request, bool with_ground_truth);
   // Puts the robot at `pose` on the ground (same height as now), at rest: for data sets of views,
   // not for runs (the sensors' state is not reset).
-  void PlaceRobot(const Pose2D& pose);
+  void PlaceRobot(const Pose2& pose);
   // A view of the world now from outside the robot (RingRenderer::RenderExternalView).
   cv::Mat RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
                              int width, int height);

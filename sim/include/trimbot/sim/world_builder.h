@@ -20,7 +20,7 @@ std::string DefaultTextureCacheDir();
 
 struct WorldOptions {
   double timestep = 0.002;        // s, fixed physics step
-  Pose2D start;                   // base_link in the map frame
+  Pose2 start;                    // base_link in the map frame
   garden::Conditions conditions;  // sun and growth
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;

@@ -17,9 +17,9 @@
 #include <optional>
 #include <variant>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/messages/sensor_messages.h"
 #include "trimbot/robot/diff_drive.h"
-#include "trimbot/stack/wheel_odometry.h"
 
 namespace trimbot::stack {
 

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/messages/commands.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/occupancy_grid.h"
 #include "trimbot/stack/path_follower.h"
-#include "trimbot/stack/wheel_odometry.h"
 
 namespace trimbot::stack {
 

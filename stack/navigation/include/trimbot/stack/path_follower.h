@@ -7,8 +7,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/messages/commands.h"
-#include "trimbot/stack/wheel_odometry.h"
 
 namespace trimbot::stack {
 

@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "trimbot/arm/arm_executive.h"
+#include "trimbot/common/pose2.h"
 #include "trimbot/messages/sensor_messages.h"
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
-#include "trimbot/stack/wheel_odometry.h"
 #include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::stack {

@@ -1,4 +1,4 @@
-#include "loop/trial_world.h"
+#include "loop/prepared_trial.h"
 
 #include "loop/prior_knowledge.h"
 
@@ -8,11 +8,11 @@ namespace {
 // The garden as it is in the trials - its objects, the scenario's unmapped objects, foliage at the
 // conditions' growth - on the prior map's cells (for plots and clearance: what the robot's map lacks).
 garden::OccupancyMap TrueMap(const Scenario& scenario, const garden::Garden& built) {
-  garden::Garden world = built;
-  world.AddObjects(scenario.survey.unmapped_objects);
+  garden::Garden in_trials = built;
+  in_trials.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
-  as_grown.growth = scenario.world.conditions.growth;
-  return garden::MakeOccupancyMap(SurveyedGarden(world, as_grown, scenario.source), scenario.map_resolution,
+  as_grown.growth = scenario.setting.conditions.growth;
+  return garden::MakeOccupancyMap(SurveyedGarden(in_trials, as_grown, scenario.source), scenario.map_resolution,
                                   scenario.map_clearance_height);
 }
 
@@ -31,21 +31,21 @@ std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const garden::Garden
 
 }  // namespace
 
-TrialWorld PrepareTrialWorld(const Scenario& scenario, const ProjectPaths& paths) {
-  TrialWorld world;
+PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths) {
+  PreparedTrial prepared;
   // In the order the checks have always run, so that the first problem is the one reported.
-  world.stack_parameters = StackParametersFor(scenario, paths);
-  world.garden = garden::Garden::Load(ResolveGarden(scenario.world, paths));
-  world.surveyed = SurveyedGarden(world.garden, scenario.survey, scenario.source);
-  world.prior_map = PriorMap(scenario, world.surveyed);
-  world.mission = MissionGoals(scenario, world.surveyed);
+  prepared.stack_parameters = StackParametersFor(scenario, paths);
+  prepared.garden = LoadGarden(scenario.setting, paths);
+  prepared.surveyed = SurveyedGarden(prepared.garden, scenario.survey, scenario.source);
+  prepared.prior_map = PriorMap(scenario, prepared.surveyed);
+  prepared.mission = MissionGoals(scenario, prepared.surveyed);
   if (scenario.arm_reach) {
-    BushOf(world.garden, scenario.arm_reach->bush, scenario,
+    BushOf(prepared.garden, scenario.arm_reach->bush, scenario,
            "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
   }
-  world.goal_truths = GoalTruths(scenario, world.garden);
-  world.true_map = TrueMap(scenario, world.garden);
-  return world;
+  prepared.goal_truths = GoalTruths(scenario, prepared.garden);
+  prepared.true_map = TrueMap(scenario, prepared.garden);
+  return prepared;
 }
 
 std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals) {

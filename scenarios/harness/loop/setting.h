@@ -1,6 +1,7 @@
 #pragma once
-// Where the project's data lives, and the one description of the world a run happens in (used by
-// scenarios and drive plans alike), turned into a simulator configuration in one place.
+// Where the project's data lives, and a run's setting - the one description of where and when a
+// run happens, read alike from scenarios and drive plans - turned into a simulator configuration in
+// one place. ("World" is kept for the simulated MuJoCo world the setting is composed into.)
 #include <cstdint>
 #include <string>
 
@@ -23,25 +24,28 @@ struct ProjectPaths {
   static ProjectPaths Default();
 };
 
-// The world of a run: which garden, where the robot really stands at the start, the conditions,
+// The setting of a run: which garden, where the robot really stands at the start, the conditions,
 // and the seed of the run's noise, faults and dynamics.
-struct WorldSetup {
+struct Setting {
   std::string garden;             // name in garden_scenes/gardens/ or a file
-  sim::Pose2D start;              // true start pose of base_link (map frame)
+  Pose2 start;                    // true start pose of base_link (map frame)
   garden::Conditions conditions;  // time of day, season, growth
   std::uint64_t seed = 0;
   std::string source;  // the file it was read from, for errors
 
   // Reads `garden`, `start`, `conditions` (and `seed` when `with_seed`) from a scenario or plan.
-  static WorldSetup Read(const YamlMap& root, bool with_seed);
+  static Setting Read(const YamlMap& root, bool with_seed);
 };
 
-// The garden file of `world`; an unknown garden is an error naming the scenario or plan's key.
-std::string ResolveGarden(const WorldSetup& world, const ProjectPaths& paths);
+// The garden file of `setting`; an unknown garden is an error naming the scenario or plan's key.
+std::string ResolveGarden(const Setting& setting, const ProjectPaths& paths);
+// The garden of `setting`, read from its file.
+garden::Garden LoadGarden(const Setting& setting, const ProjectPaths& paths);
 
-// The simulator configuration for `world` with the project's robot, composing its MuJoCo world in
-// `world_dir`; rendering, noise and faults at their defaults for the caller to set.
-sim::SimulatorConfig MakeSimulatorConfig(const ProjectPaths& paths, const WorldSetup& world,
+// The simulator configuration for `setting` in `garden` (the setting's, read once by the caller)
+// with the project's robot, composing its MuJoCo world in `world_dir`; rendering, noise and faults
+// at their defaults for the caller to set.
+sim::SimulatorConfig MakeSimulatorConfig(const ProjectPaths& paths, const Setting& setting, garden::Garden garden,
                                          const std::string& world_dir);
 
 }  // namespace trimbot::scenarios

@@ -1,5 +1,5 @@
 #pragma once
-// A scenario's trial world, prepared once and passed as a value to whoever needs it: the garden
+// A scenario's trial, prepared once and passed as a value to whoever needs it: the garden
 // file is read once per batch, not once per use. It holds both sides of a trial, and each side
 // goes only where it belongs:
 //   what the robot is told  - the prior map, the mission, the stack's parameters -> RobotStack
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "loop/scenario.h"
-#include "loop/world_setup.h"
+#include "loop/setting.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/stack/robot_stack.h"
@@ -22,7 +22,7 @@ struct GoalTruth {
   int bush = 0;                                        // garden object id; 0: a point goal
 };
 
-struct TrialWorld {
+struct PreparedTrial {
   garden::Garden garden;                    // the garden file as built (the simulator adds the unmapped objects)
   garden::Garden surveyed;                  // the garden as the survey recorded it (prior_knowledge.h)
   garden::OccupancyMap prior_map;           // the robot's prior map: the surveyed garden's obstacles
@@ -35,7 +35,7 @@ struct TrialWorld {
 // Reads the scenario's garden and prepares its world. Throws InputError naming the scenario (an
 // unknown garden, a goal or arm_reach bush that is not a bush, a survey naming a missing object,
 // stack parameters that do not fit the scenario).
-TrialWorld PrepareTrialWorld(const Scenario& scenario, const ProjectPaths& paths);
+PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths);
 
 // The goals' positions as planned (a bush goal: its surveyed centre), for plots.
 std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals);
