@@ -92,12 +92,14 @@ void ExpectSameTrial(const TrialResult& a, const TrialResult& b) {
   EXPECT_EQ(a.fixes_accepted, b.fixes_accepted);
   EXPECT_EQ(a.fixes_rejected, b.fixes_rejected);
   EXPECT_EQ(a.relocalizations, b.relocalizations);
+  EXPECT_EQ(a.visual_frames_attempted, b.visual_frames_attempted);
   EXPECT_EQ(a.faults, b.faults);
   ASSERT_EQ(a.estimates.size(), b.estimates.size());
   for (std::size_t i = 0; i < a.estimates.size(); ++i) {
     EXPECT_EQ(a.estimates[i].name, b.estimates[i].name);
     EXPECT_EQ(a.estimates[i].position_m, b.estimates[i].position_m);  // exact: doubles must survive the text
     EXPECT_EQ(a.estimates[i].heading_deg, b.estimates[i].heading_deg);
+    EXPECT_EQ(a.estimates[i].nees, b.estimates[i].nees);
   }
 }
 
@@ -119,9 +121,11 @@ TEST(TrialResultJson, RoundTripIsLossless) {
   trial.fixes_accepted = 40;
   trial.fixes_rejected = 3;
   trial.relocalizations = 1;
+  trial.visual_frames_attempted = 57;
   trial.faults = {"camera 3 dropped at 20 s", "wheel slip 10 %"};
   trial.estimates = {Estimate("ekf", {0.1, 0.2, 1e-17, 0.30000000000000004}, {0.5, 179.9}),
                      Estimate("pose_fixes", {}, {})};
+  trial.estimates[0].nees = {2.5, 1e-9, 31.0};
 
   const nlohmann::json written = trial;
   // Through text, as the file is written and read.
@@ -196,6 +200,39 @@ TEST(BatchMetrics, RatesMeansAndPooledErrors) {
   const nlohmann::json four = ComputeBatchMetrics(ThreeTrials(), 4);
   EXPECT_DOUBLE_EQ(four["success_rate"].get<double>(), 0.25);
   EXPECT_DOUBLE_EQ(four["goal_success_rate"].get<double>(), 3.0 / 8.0);
+}
+
+// Per-frame success of the stack's visual localization: fixes the EKF accepted over the frames the
+// localizer attempted, pooled over the trials it ran in; a trial with the simulated fixture (no
+// frames attempted) counts in neither.
+TEST(BatchMetrics, VisualFrameSuccessIsPooledOverTheTrialsThatLocalized) {
+  std::vector<TrialResult> trials(3);
+  trials[0].visual_frames_attempted = 100;
+  trials[0].fixes_accepted = 80;
+  trials[0].simulated_seconds = 50.0;
+  trials[1].visual_frames_attempted = 60;
+  trials[1].fixes_accepted = 30;
+  trials[1].simulated_seconds = 30.0;
+  trials[2].fixes_accepted = 500;  // the simulated_pose_fixes fixture
+  trials[2].simulated_seconds = 100.0;
+  const nlohmann::json m = ComputeBatchMetrics(trials, 3);
+  EXPECT_DOUBLE_EQ(m["visual_frame_success_rate"].get<double>(), 110.0 / 160.0);
+  EXPECT_DOUBLE_EQ(m["visual_frame_rate_hz"].get<double>(), 160.0 / 80.0);
+  EXPECT_FALSE(ComputeBatchMetrics(ThreeTrials(), 3).contains("visual_frame_success_rate"));
+}
+
+// The EKF's consistency, pooled over trials: the mean NEES, and the share of samples below the 95 %
+// quantile of chi-square with 3 dof; estimates without NEES samples have neither.
+TEST(BatchMetrics, NeesIsPooledOverTrials) {
+  std::vector<TrialResult> trials(2);
+  trials[0].estimates = {Estimate("ekf", {0.1, 0.1}, {1.0, 1.0}), Estimate("wheel_odometry", {0.2}, {2.0})};
+  trials[0].estimates[0].nees = {1.0, 2.0};
+  trials[1].estimates = {Estimate("ekf", {0.1, 0.1}, {1.0, 1.0})};
+  trials[1].estimates[0].nees = {9.0, 4.0};
+  const nlohmann::json m = ComputeBatchMetrics(trials, 2);
+  EXPECT_DOUBLE_EQ(m["ekf_nees_mean"].get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(m["ekf_nees_within_95_rate"].get<double>(), 0.75);  // 9 > 7.81
+  EXPECT_FALSE(m.contains("wheel_odometry_nees_mean"));
 }
 
 BatchSummary SummaryWithTwoGoodTrials() {

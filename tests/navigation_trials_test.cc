@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -82,6 +83,7 @@ TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
 TEST(PriorKnowledge, TheMapIsTheGardenAsSurveyed) {
   const garden::Garden built = garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml"));
   Survey survey;
+  survey.point_sigma = 0.0;  // exact, to see growth, unmapped and gone alone
   survey.growth = 1.0;
   survey.unmapped = {17};
   garden::GardenObject gone;
@@ -103,6 +105,44 @@ TEST(PriorKnowledge, TheMapIsTheGardenAsSurveyed) {
   EXPECT_EQ(find(surveyed, 5)->size, fence->size) << "a fence does not grow";
   survey.unmapped = {12345};
   EXPECT_THROW(SurveyedGarden(built, survey, "test.yaml"), InputError);
+}
+
+// A tape survey's errors: centres off by the point sigma per axis, extents by sqrt(2) of it, the
+// yaw of elongated objects by sqrt(2) of it over their length, round ones' not at all; the same
+// seed gives the same survey, another seed another.
+TEST(PriorKnowledge, ASurveyCarriesTapeErrors) {
+  const garden::Garden built = garden::Garden::Load(testing::SourcePath("garden_scenes/gardens/wageningen.yaml"));
+  Survey survey;
+  survey.seed = 11;
+  ASSERT_EQ(survey.point_sigma, kTapeSurveyPointSigma) << "surveys carry errors by default";
+  const garden::Garden surveyed = SurveyedGarden(built, survey, "test.yaml");
+  ASSERT_EQ(surveyed.objects.size(), built.objects.size());
+  double centre_sq = 0.0, extent_sq = 0.0;
+  int centres = 0, extents = 0;
+  for (std::size_t i = 0; i < built.objects.size(); ++i) {
+    const garden::GardenObject &truth = built.objects[i], &seen = surveyed.objects[i];
+    ASSERT_EQ(truth.id, seen.id);
+    centre_sq += (seen.position - truth.position).squaredNorm();
+    centres += 2;
+    for (int k = 0; k < 3; ++k) {
+      if (seen.size[k] > 0.5 * truth.size[k]) {  // not clamped
+        extent_sq += std::pow(seen.size[k] - truth.size[k], 2);
+        ++extents;
+      }
+    }
+    const bool round = truth.shape != garden::Shape::kBox && truth.size.x() == truth.size.y();
+    if (round) EXPECT_EQ(seen.yaw, truth.yaw) << "object " << truth.id;
+    if (!round) EXPECT_NE(seen.yaw, truth.yaw) << "object " << truth.id;
+  }
+  ASSERT_GT(centres, 40);
+  // Sample standard deviations of 40+ draws: within 30 % of the sigma is beyond 3 of their sigmas.
+  EXPECT_NEAR(std::sqrt(centre_sq / centres), survey.point_sigma, 0.3 * survey.point_sigma);
+  EXPECT_NEAR(std::sqrt(extent_sq / extents), std::sqrt(2.0) * survey.point_sigma, 0.3 * survey.point_sigma);
+
+  const garden::Garden again = SurveyedGarden(built, survey, "test.yaml");
+  EXPECT_EQ(again.objects[0].position, surveyed.objects[0].position);
+  survey.seed = 12;
+  EXPECT_NE(SurveyedGarden(built, survey, "test.yaml").objects[0].position, surveyed.objects[0].position);
 }
 
 // The stack starts from the true start plus the seeded placement error, and reads a calibration

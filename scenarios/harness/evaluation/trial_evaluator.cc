@@ -1,5 +1,6 @@
 #include "evaluation/trial_evaluator.h"
 
+#include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -175,6 +176,9 @@ void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   const Pose2& odometry = step.telemetry->odometry;
   sample_times_.push_back(step.time);
   AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
+  const Eigen::Vector3d error(estimate.x - truth.x, estimate.y - truth.y, AngleDifference(estimate.yaw, truth.yaw));
+  const double nees = error.dot(step.telemetry->estimate.covariance.ldlt().solve(error));
+  if (std::isfinite(nees)) ekf_.nees.push_back(nees);  // a covariance of zero (an exact start) has none
   AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);
   truth_tum_ += Tum(truth.t, {truth.x, truth.y, truth.yaw});
   ekf_tum_ += Tum(step.time, estimate);
@@ -236,6 +240,7 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   result->estimates = {ekf_, odometry_, fixes_};
   result->bush_frames = bush_frames_;
   result->localization_rate = LocalizationRate();
+  result->visual_frames_attempted = telemetry.visual.attempts;
   const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
   result->success = result->status == "completed" && all_reached && collisions_ == 0;
   if (result->status == "completed" && !result->success) {

@@ -35,12 +35,14 @@ void to_json(nlohmann::json& j, const EstimateErrors& e) {
        {"heading_deg", e.heading_deg},
        {"position_stats_m", e.position()},
        {"heading_stats_deg", e.heading()}};
+  if (!e.nees.empty()) j["nees"] = e.nees;
 }
 
 void from_json(const nlohmann::json& j, EstimateErrors& e) {
   j.at("name").get_to(e.name);
   j.at("position_m").get_to(e.position_m);
   j.at("heading_deg").get_to(e.heading_deg);
+  if (j.contains("nees")) j.at("nees").get_to(e.nees);
 }
 
 void to_json(nlohmann::json& j, const GoalResult& g) {
@@ -114,6 +116,7 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"fixes_rejected", t.fixes_rejected},
        {"relocalizations", t.relocalizations},
        {"localization_rate", t.localization_rate},
+       {"visual_frames_attempted", t.visual_frames_attempted},
        {"faults", t.faults},
        {"estimates", t.estimates}};
   if (t.min_clearance_m) j["min_clearance_m"] = *t.min_clearance_m;
@@ -141,6 +144,7 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   j.at("fixes_rejected").get_to(t.fixes_rejected);
   j.at("relocalizations").get_to(t.relocalizations);
   t.localization_rate = j.value("localization_rate", -1.0);
+  t.visual_frames_attempted = j.value("visual_frames_attempted", 0);
   j.at("faults").get_to(t.faults);
   j.at("estimates").get_to(t.estimates);
   if (j.contains("min_clearance_m")) t.min_clearance_m = j.at("min_clearance_m").get<double>();
@@ -254,6 +258,58 @@ void AddArmMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metri
   metrics["arm_cutter_path_length_mean_m"] = ErrorStats::From(cutter_path).mean;
 }
 
+// Localization: the localization rate, the visual localizer's per-frame success and rate, and
+// each estimate's errors (and the EKF's NEES) over the samples pooled from every trial.
+void AddLocalizationMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
+  std::vector<double> localization_rates;
+  int visual_frames = 0, visual_frames_fixed = 0;
+  double visual_seconds = 0.0;
+  std::vector<std::string> estimate_names;  // in order of first appearance
+  std::map<std::string, std::vector<double>> pooled_position_m, pooled_heading_deg, pooled_nees;
+  for (const TrialResult& trial : trials) {
+    if (trial.localization_rate >= 0.0) localization_rates.push_back(trial.localization_rate);
+    if (trial.visual_frames_attempted > 0) {
+      visual_frames += trial.visual_frames_attempted;
+      visual_frames_fixed += trial.fixes_accepted;
+      visual_seconds += trial.simulated_seconds;
+    }
+    for (const EstimateErrors& estimate : trial.estimates) {
+      if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
+      auto& position = pooled_position_m[estimate.name];
+      auto& heading = pooled_heading_deg[estimate.name];
+      auto& nees = pooled_nees[estimate.name];
+      position.insert(position.end(), estimate.position_m.begin(), estimate.position_m.end());
+      heading.insert(heading.end(), estimate.heading_deg.begin(), estimate.heading_deg.end());
+      nees.insert(nees.end(), estimate.nees.begin(), estimate.nees.end());
+    }
+  }
+  if (!localization_rates.empty()) metrics["localization_rate"] = ErrorStats::From(localization_rates).mean;
+  if (visual_frames > 0) {
+    metrics["visual_frame_success_rate"] = static_cast<double>(visual_frames_fixed) / visual_frames;
+    metrics["visual_frame_rate_hz"] = visual_frames / visual_seconds;
+  }
+  for (const std::string& name : estimate_names) {
+    // An estimate without samples (e.g. no pose fix arrived) has no error metrics, so a criterion
+    // on it fails as "not measured" instead of passing with 0.
+    if (pooled_position_m[name].empty()) continue;
+    const ErrorStats position = ErrorStats::From(pooled_position_m[name]);
+    const ErrorStats heading = ErrorStats::From(pooled_heading_deg[name]);
+    metrics[name + "_position_error_mean_m"] = position.mean;
+    metrics[name + "_position_error_median_m"] = position.median;
+    metrics[name + "_position_error_max_m"] = position.max;
+    metrics[name + "_position_error_rmse_m"] = position.rmse;
+    metrics[name + "_heading_error_mean_deg"] = heading.mean;
+    metrics[name + "_heading_error_median_deg"] = heading.median;
+    metrics[name + "_heading_error_max_deg"] = heading.max;
+    const std::vector<double>& nees = pooled_nees[name];
+    if (!nees.empty()) {
+      const auto within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
+      metrics[name + "_nees_mean"] = ErrorStats::From(nees).mean;
+      metrics[name + "_nees_within_95_rate"] = static_cast<double>(within) / static_cast<double>(nees.size());
+    }
+  }
+}
+
 }  // namespace
 
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned) {
@@ -263,9 +319,6 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   int goals_per_trial = 0;
   double simulated_seconds = 0.0, path_length_m = 0.0;
   std::optional<double> min_clearance_m;
-  std::vector<double> localization_rates;
-  std::vector<std::string> estimate_names;  // in order of first appearance
-  std::map<std::string, std::vector<double>> pooled_position_m, pooled_heading_deg;
   for (const TrialResult& trial : trials) {
     successes += trial.success ? 1 : 0;
     completed += trial.status == "completed" ? 1 : 0;
@@ -278,14 +331,6 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
     path_length_m += trial.path_length_m;
     if (trial.min_clearance_m)
       min_clearance_m = std::min(min_clearance_m.value_or(*trial.min_clearance_m), *trial.min_clearance_m);
-    if (trial.localization_rate >= 0.0) localization_rates.push_back(trial.localization_rate);
-    for (const EstimateErrors& estimate : trial.estimates) {
-      if (!pooled_position_m.count(estimate.name)) estimate_names.push_back(estimate.name);
-      auto& position = pooled_position_m[estimate.name];
-      auto& heading = pooled_heading_deg[estimate.name];
-      position.insert(position.end(), estimate.position_m.begin(), estimate.position_m.end());
-      heading.insert(heading.end(), estimate.heading_deg.begin(), estimate.heading_deg.end());
-    }
   }
 
   const auto ratio = [](double numerator, double denominator) {
@@ -301,21 +346,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   metrics["mean_trial_seconds"] = ratio(simulated_seconds, ran);
   metrics["mean_path_length_m"] = ratio(path_length_m, ran);
   if (min_clearance_m) metrics["min_clearance_m"] = *min_clearance_m;  // over all trials
-  if (!localization_rates.empty()) metrics["localization_rate"] = ErrorStats::From(localization_rates).mean;
-  for (const std::string& name : estimate_names) {
-    // An estimate without samples (e.g. no pose fix arrived) has no error metrics, so a criterion
-    // on it fails as "not measured" instead of passing with 0.
-    if (pooled_position_m[name].empty()) continue;
-    const ErrorStats position = ErrorStats::From(pooled_position_m[name]);
-    const ErrorStats heading = ErrorStats::From(pooled_heading_deg[name]);
-    metrics[name + "_position_error_mean_m"] = position.mean;
-    metrics[name + "_position_error_median_m"] = position.median;
-    metrics[name + "_position_error_max_m"] = position.max;
-    metrics[name + "_position_error_rmse_m"] = position.rmse;
-    metrics[name + "_heading_error_mean_deg"] = heading.mean;
-    metrics[name + "_heading_error_median_deg"] = heading.median;
-    metrics[name + "_heading_error_max_deg"] = heading.max;
-  }
+  AddLocalizationMetrics(trials, metrics);
   AddBushMetrics(trials, metrics);
   AddArmMetrics(trials, metrics);
   return metrics;

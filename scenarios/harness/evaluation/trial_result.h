@@ -19,10 +19,17 @@ struct ErrorStats {
 
 // Error of one pose estimate (ekf, wheel_odometry, pose_fixes) against ground truth, sampled at
 // the estimate's own stamps (fixes) or at the evaluation rate (filters).
+// The 95 % quantile of the chi-square distribution with 3 degrees of freedom.
+constexpr double kChiSquare3Dof95 = 7.8147;
+
 struct EstimateErrors {
   std::string name;
   std::vector<double> position_m;   // samples, metres
   std::vector<double> heading_deg;  // samples, degrees (absolute)
+  // Normalized estimation error squared of (x, y, yaw) under the estimate's own covariance, per
+  // sample (the EKF only): a consistent filter's is chi-square with 3 dof (mean 3, 95 % of samples
+  // below 7.81).
+  std::vector<double> nees;
   ErrorStats position() const { return ErrorStats::From(position_m); }
   ErrorStats heading() const { return ErrorStats::From(heading_deg); }
 };
@@ -102,6 +109,9 @@ struct TrialResult {
   // Share of the 10 Hz evaluation samples, from the first pose fix on, with a fix stamped within
   // 0.5 s (Table 2's last column of D3.4); -1 when no fix arrived.
   double localization_rate = -1.0;
+  // Ring frames the stack's visual localizer tried (0: it did not run). With fixes_accepted, the
+  // per-frame success the localization rate hides: at 2 Hz one fix covers a whole second.
+  int visual_frames_attempted = 0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
   std::vector<BushFrame> bush_frames;        // bush goals' sightings
@@ -146,9 +156,12 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 
 // Batch metrics from the trials: success_rate (trials with success / trials planned; a trial that
 // never ran counts as failed), goal_success_rate, trials_completed, collisions, recoveries,
-// mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), and per estimate
+// mean_trial_seconds (simulated), mean_path_length_m, localization_rate (mean over trials with fixes), with the
+// stack's visual localization visual_frame_success_rate (fixes the EKF accepted / frames attempted, pooled) and
+// visual_frame_rate_hz (frames attempted per simulated second), and per estimate
 // E (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
-// E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples);
+// E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples), and for the
+// EKF its consistency: ekf_nees_mean (3 when consistent) and ekf_nees_within_95_rate (0.95 when consistent);
 // with bush goals: bush_goals, bush_{distance,bearing}_error_{mean,max} (final pose, absolute,
 // m / deg), bush_estimate_{distance,bearing}_error_{mean,max} (the stack's final estimate), and
 // over the frames at 1-3 m: bush_frames_1_3m, bush_frame_found_rate, bush_frame_{distance,

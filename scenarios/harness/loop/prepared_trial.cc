@@ -11,6 +11,7 @@ garden::OccupancyMap TrueMap(const Scenario& scenario, const garden::Garden& bui
   garden::Garden in_trials = built;
   in_trials.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
+  as_grown.point_sigma = 0.0;  // the truth, not a survey
   as_grown.growth = scenario.setting.conditions.growth;
   return garden::MakeOccupancyMap(SurveyedGarden(in_trials, as_grown, scenario.source), scenario.map_resolution,
                                   scenario.map_clearance_height);

@@ -14,6 +14,27 @@
 #include "trimbot/robot/robot_files.h"
 
 namespace trimbot::scenarios {
+namespace {
+
+// What a tape survey records of `object` (Survey::point_sigma): its centre off by one point's
+// error, each extent by two, an elongated object's yaw by its two ends' over its length. Each
+// object draws from its own stream (by id), so removing one object leaves the others' errors.
+void AddSurveyError(const Survey& survey, garden::GardenObject& object) {
+  Rng rng = MakeRng(survey.seed, "survey/object/" + std::to_string(object.id));
+  const double sigma = survey.point_sigma;
+  const Eigen::Vector2d centre_error(StandardNormal(rng), StandardNormal(rng));
+  const Eigen::Vector3d extent_error(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+  const double yaw_error = StandardNormal(rng);
+  const double length = object.size.head<2>().maxCoeff();
+  // A round object (cylinder or ellipsoid with equal extents) has no yaw to measure.
+  const bool elongated = object.shape == garden::Shape::kBox || object.size.x() != object.size.y();
+  object.position += sigma * centre_error;
+  // A tape cannot read less than half the true extent (a 3-sigma error on a 5 cm post would).
+  object.size = (object.size + std::sqrt(2.0) * sigma * extent_error).cwiseMax(0.5 * object.size);
+  if (elongated) object.yaw += std::sqrt(2.0) * sigma / length * yaw_error;
+}
+
+}  // namespace
 
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file) {
   garden::Garden surveyed = built;
@@ -37,6 +58,7 @@ garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey,
     if (garden::IsFoliage(object.object_class)) {
       object.size.head<2>() += Eigen::Vector2d::Constant(2.0 * survey.growth * garden::kMaxGrowth);
     }
+    if (survey.point_sigma > 0.0) AddSurveyError(survey, object);
   }
   surveyed.objects.insert(surveyed.objects.end(), survey.gone.begin(), survey.gone.end());
   return surveyed;

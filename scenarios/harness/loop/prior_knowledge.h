@@ -16,8 +16,9 @@
 
 namespace trimbot::scenarios {
 
-// The garden as the survey recorded it: foliage at the survey's growth, unmapped objects left
-// out, objects that are gone still in. Throws InputError (naming the scenario) for an unknown id.
+// The garden as the survey recorded it: foliage at the survey's growth, every object with the
+// survey's seeded errors (position, extents, yaw), unmapped objects left out, objects that are gone
+// still in (as the scenario gives them). Throws InputError (naming the scenario) for an unknown id.
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file);
 
 // The robot's prior map: the surveyed garden's objects below the scenario's clearance height.

@@ -60,8 +60,15 @@ SimulatedPoseFixParameters ReadSimulatedPoseFixes(const YamlMap& map) {
   return p;
 }
 
-Survey ReadSurvey(const YamlMap& map) {
+Survey ReadSurvey(const YamlMap& map, std::uint64_t scenario_seed) {
   Survey survey;
+  survey.point_sigma = map.NumberOr("point_sigma", survey.point_sigma, 0.0, 1.0, "m");
+  survey.seed = scenario_seed;
+  if (map.Has("seed")) {
+    const int seed = map.Int("seed", 1);
+    if (seed < 0) map.Fail("seed", "must not be negative");
+    survey.seed = static_cast<std::uint64_t>(seed);
+  }
   survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
   if (map.Has("unmapped")) {
     survey.unmapped = map.Integers("unmapped", 1, garden::kMaxGardenObjectId);
@@ -117,7 +124,8 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     s.map_clearance_height = map.NumberOr("clearance_height", s.map_clearance_height, 0.0, 10.0, "m");
     map.RejectUnknownKeys();
   }
-  if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"));
+  s.survey.seed = s.setting.seed;
+  if (root.Has("survey")) s.survey = ReadSurvey(root.Map("survey"), s.setting.seed);
   for (const YamlMap& goal :
        root.Has("goals") || !root.Has("arm_reach") ? root.MapList("goals") : std::vector<YamlMap>{}) {
     ScenarioGoal g;
@@ -215,6 +223,7 @@ bool IsKnownMetric(const std::string& name) {
     std::set<std::string> names = {"success_rate",       "goal_success_rate", "trials_completed",
                                    "collisions",         "recoveries",        "mean_trial_seconds",
                                    "mean_path_length_m", "localization_rate", "min_clearance_m"};
+    names.insert({"visual_frame_success_rate", "visual_frame_rate_hz", "ekf_nees_mean", "ekf_nees_within_95_rate"});
     names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
     names.insert({"arm_goals", "arm_success_rate", "arm_contacts", "arm_tracking_error_max_rad", "arm_min_clearance_m",
                   "arm_position_error_mean_m", "arm_position_error_max_m", "arm_orientation_error_mean_deg",

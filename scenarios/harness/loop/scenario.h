@@ -28,7 +28,21 @@ struct PassCriterion {
 };
 
 // How the robot's prior map differs from the garden as it stands in the simulation.
+// How well a garden survey made with tapes locates one point (m, per horizontal axis): 20 mm, what
+// trilateration from a computed network of control points reaches ("a good point position computed
+// using DSM is accurate to 20 mm", 3H Consulting, Site Surveyor: Techniques, 3D trilateration,
+// http://www.3hconsulting.com/Techniques3DTrilat.htm). A lower bound for a garden, where a bush's
+// centre and outline are picked by eye.
+constexpr double kTapeSurveyPointSigma = 0.02;
+
 struct Survey {
+  // The survey's errors (SurveyedGarden): every object's centre is a point located with
+  // `point_sigma` (m, per axis); each extent is the distance between two such points on its
+  // outline (sqrt(2) * point_sigma); an elongated object's yaw comes from its two ends (sqrt(2) *
+  // point_sigma / length). 0: an exact survey. Seeded by `seed` (default: the scenario's seed; the
+  // garden was surveyed once, so every trial of a batch shares the survey).
+  double point_sigma = kTapeSurveyPointSigma;
+  std::uint64_t seed = 0;
   double growth = 0.0;        // foliage as it was when surveyed (0..1, as Conditions)
   std::vector<int> unmapped;  // object ids the survey missed
   // Objects in the world that are not in the garden file either (a wheelbarrow left on the lawn):
