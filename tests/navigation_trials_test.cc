@@ -217,13 +217,19 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
       EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
     }
   }
-  // A real bush gives the stack its surveyed centre and shape.
+  // A real bush gives the stack its surveyed centre and shape: the survey's, off the true centre
+  // (1.5, -2.2) by the survey's error, and the truth stays with the evaluation.
   const Scenario ok = Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0\\}", "{approach_bush: 3}"));
-  const std::vector<stack::Goal> goals = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR}).mission;
+  const PreparedTrial prepared = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  const std::vector<stack::Goal>& goals = prepared.mission;
   ASSERT_EQ(goals.size(), 1u);
   ASSERT_TRUE(goals[0].bush.has_value());
   EXPECT_EQ(goals[0].bush->kind, perception::BushShape::Kind::kCylinder);
-  EXPECT_NEAR((goals[0].position - Eigen::Vector2d(1.5, -2.2)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(goals[0].position, BushOf(prepared.surveyed, 3, ok, "test").position);
+  const double survey_error = (goals[0].position - Eigen::Vector2d(1.5, -2.2)).norm();
+  EXPECT_GT(survey_error, 0.0);
+  EXPECT_LT(survey_error, 4.0 * std::sqrt(2.0) * ok.survey.point_sigma);
+  EXPECT_EQ(prepared.goal_truths[0].position, Eigen::Vector2d(1.5, -2.2));
 }
 
 // A goal that some headings cannot arrive at (the footprint would touch a rose on the last

@@ -10,11 +10,12 @@
 namespace trimbot::stack {
 namespace {
 
-using Vector6 = Ekf::Vector6;
-using Matrix6 = Ekf::Matrix6;
+using StateVector = Ekf::StateVector;
+using StateMatrix = Ekf::StateMatrix;
+constexpr int kN = Ekf::kStateSize;
 
 // State layout.
-constexpr int kX = 0, kY = 1, kYaw = 2, kV = 3, kW = 4, kBias = 5;
+constexpr int kX = 0, kY = 1, kYaw = 2, kV = 3, kW = 4, kBias = 5, kScale = 6;
 
 // Prior on the states Initialize() is not told about. The first wheel speeds settle v and w at
 // once; the bias prior is a MEMS gyro's turn-on bias (about 1 deg/s).
@@ -52,13 +53,17 @@ double SincDerivative(double a) {
 // bias stay. The arc's chord has length v dt sinc(w dt / 2) along the mid-step heading, which is
 // exact and, unlike (v / w)(sin(yaw + w dt) - sin(yaw)), stays accurate as w -> 0. Returns the
 // moved state and the exact Jacobian of that motion.
-void PropagateMotion(const Vector6& x, double dt, Vector6* moved, Matrix6* F) {
+void PropagateMotion(const StateVector& x, double dt, StateVector* moved, StateMatrix* F) {
+  // v is the speed the wheels turn at; the base moves over the ground at v / (1 + wheel_scale).
   const double v = x(kV), w = x(kW);
+  const double per_ground = 1.0 / (1.0 + x(kScale));
+  const double ground = v * per_ground;
   const double half_turn = 0.5 * w * dt;
   const double heading = x(kYaw) + half_turn;  // of the chord
   const double c = std::cos(heading), s = std::sin(heading);
-  const double chord = v * dt * Sinc(half_turn);
-  const double chord_per_w = v * dt * SincDerivative(half_turn) * 0.5 * dt;  // d chord / d w
+  const double chord = ground * dt * Sinc(half_turn);
+  const double chord_per_w = ground * dt * SincDerivative(half_turn) * 0.5 * dt;  // d chord / d w
+  const double chord_per_scale = -chord * per_ground;                             // d chord / d wheel_scale
   *moved = x;
   (*moved)(kX) += chord * c;
   (*moved)(kY) += chord * s;
@@ -66,8 +71,10 @@ void PropagateMotion(const Vector6& x, double dt, Vector6* moved, Matrix6* F) {
   F->setIdentity();
   (*F)(kX, kYaw) = -chord * s;
   (*F)(kY, kYaw) = chord * c;
-  (*F)(kX, kV) = dt * Sinc(half_turn) * c;
-  (*F)(kY, kV) = dt * Sinc(half_turn) * s;
+  (*F)(kX, kV) = per_ground * dt * Sinc(half_turn) * c;
+  (*F)(kY, kV) = per_ground * dt * Sinc(half_turn) * s;
+  (*F)(kX, kScale) = chord_per_scale * c;
+  (*F)(kY, kScale) = chord_per_scale * s;
   (*F)(kX, kW) = chord_per_w * c - chord * s * 0.5 * dt;
   (*F)(kY, kW) = chord_per_w * s + chord * c * 0.5 * dt;
   (*F)(kYaw, kW) = dt;
@@ -77,14 +84,14 @@ void PropagateMotion(const Vector6& x, double dt, Vector6* moved, Matrix6* F) {
 // [dt^3/3, dt^2/2; dt^2/2, dt] * density^2. Linear acceleration moves the position along the
 // (mid-step) heading; angular acceleration moves yaw. The cross-track position noise that a yaw
 // error causes is O(dt^4) and left to the Jacobian of the next steps.
-Matrix6 ProcessNoise(const Vector6& x, double dt, const EkfParameters& p) {
+StateMatrix ProcessNoise(const StateVector& x, double dt, const EkfParameters& p) {
   const double q_linear = p.linear_acceleration_density * p.linear_acceleration_density;
   const double q_angular = p.angular_acceleration_density * p.angular_acceleration_density;
   const double q_bias = p.gyro_bias_random_walk * p.gyro_bias_random_walk;
   const double heading = x(kYaw) + 0.5 * x(kW) * dt;
   const Eigen::Vector2d along(std::cos(heading), std::sin(heading));
   const double dt2 = dt * dt, dt3 = dt2 * dt;
-  Matrix6 Q = Matrix6::Zero();
+  StateMatrix Q = StateMatrix::Zero();
   Q.block<2, 2>(kX, kX) = q_linear * dt3 / 3.0 * along * along.transpose();
   Q.block<2, 1>(kX, kV) = q_linear * dt2 / 2.0 * along;
   Q.block<1, 2>(kV, kX) = Q.block<2, 1>(kX, kV).transpose();
@@ -93,29 +100,30 @@ Matrix6 ProcessNoise(const Vector6& x, double dt, const EkfParameters& p) {
   Q(kYaw, kW) = Q(kW, kYaw) = q_angular * dt2 / 2.0;
   Q(kW, kW) = q_angular * dt;
   Q(kBias, kBias) = q_bias * dt;
+  Q(kScale, kScale) = p.wheel_scale_random_walk * p.wheel_scale_random_walk * dt;
   return Q;
 }
 
-void Propagate(const Vector6& x, const Matrix6& P, double dt, const EkfParameters& parameters, Vector6* x_out,
-               Matrix6* P_out) {
+void Propagate(const StateVector& x, const StateMatrix& P, double dt, const EkfParameters& parameters,
+               StateVector* x_out, StateMatrix* P_out) {
   if (dt <= 0.0) {
     *x_out = x;
     *P_out = P;
     return;
   }
-  Matrix6 F;
+  StateMatrix F;
   PropagateMotion(x, dt, x_out, &F);
-  const Matrix6 predicted = F * P * F.transpose() + ProcessNoise(x, dt, parameters);
+  const StateMatrix predicted = F * P * F.transpose() + ProcessNoise(x, dt, parameters);
   *P_out = 0.5 * (predicted + predicted.transpose());
 }
 
 // Measurement model of a pose fix: z = (x, y, yaw), the yaw innovation wrapped.
-Eigen::Vector3d PoseInnovation(const messages::PoseFix& fix, const Vector6& x) {
+Eigen::Vector3d PoseInnovation(const messages::PoseFix& fix, const StateVector& x) {
   return {fix.x - x(kX), fix.y - x(kY), WrapAngle(fix.yaw - x(kYaw))};
 }
 
-Eigen::Matrix<double, 3, 6> PoseJacobian() {
-  Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
+Eigen::Matrix<double, 3, kN> PoseJacobian() {
+  Eigen::Matrix<double, 3, kN> H = Eigen::Matrix<double, 3, kN>::Zero();
   H.leftCols<3>().setIdentity();
   return H;
 }
@@ -124,17 +132,17 @@ Eigen::Matrix<double, 3, 6> PoseJacobian() {
 // Writes nothing and returns false if the innovation covariance is not positive definite or the
 // result is not finite.
 template <int M>
-bool KalmanUpdate(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Matrix<double, M, 6>& H,
-                  const Eigen::Matrix<double, M, M>& R, Vector6* x, Matrix6* P) {
+bool KalmanUpdate(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Matrix<double, M, kN>& H,
+                  const Eigen::Matrix<double, M, M>& R, StateVector* x, StateMatrix* P) {
   const Eigen::Matrix<double, M, M> S = H * (*P) * H.transpose() + R;
   const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
   if (llt.info() != Eigen::Success) return false;
   // K = P H^T S^-1, computed as (S^-1 H P)^T since S and P are symmetric.
-  const Eigen::Matrix<double, 6, M> K = llt.solve(H * (*P)).transpose();
-  Vector6 x_new = *x + K * innovation;
+  const Eigen::Matrix<double, kN, M> K = llt.solve(H * (*P)).transpose();
+  StateVector x_new = *x + K * innovation;
   x_new(kYaw) = WrapAngle(x_new(kYaw));
-  const Matrix6 I_KH = Matrix6::Identity() - K * H;
-  Matrix6 P_new = I_KH * (*P) * I_KH.transpose() + K * R * K.transpose();
+  const StateMatrix I_KH = StateMatrix::Identity() - K * H;
+  StateMatrix P_new = I_KH * (*P) * I_KH.transpose() + K * R * K.transpose();
   P_new = 0.5 * (P_new + P_new.transpose());
   if (!x_new.allFinite() || !P_new.allFinite()) return false;
   *x = x_new;
@@ -154,12 +162,13 @@ void Ekf::Initialize(double stamp, const Pose2& pose, const Eigen::Matrix3d& pos
     return;
   }
   stamp_ = stamp;
-  x_ << pose.x, pose.y, WrapAngle(pose.yaw), 0.0, 0.0, 0.0;
+  x_ << pose.x, pose.y, WrapAngle(pose.yaw), 0.0, 0.0, 0.0, 0.0;
   P_.setZero();
   P_.topLeftCorner<3, 3>() = pose_covariance;
   P_(kV, kV) = kInitialSpeedSigma * kInitialSpeedSigma;
   P_(kW, kW) = kInitialTurnRateSigma * kInitialTurnRateSigma;
   P_(kBias, kBias) = kInitialGyroBiasSigma * kInitialGyroBiasSigma;
+  P_(kScale, kScale) = parameters_.wheel_scale_sigma * parameters_.wheel_scale_sigma;
   last_ticks_.reset();
   last_imu_stamp_.reset();
   history_.clear();
@@ -223,8 +232,8 @@ FixOutcome Ekf::AddPoseFix(const messages::PoseFix& fix) {
   }
 
   // Gate against the filter's prediction at the fix's own time.
-  Vector6 x;
-  Matrix6 P;
+  StateVector x;
+  StateMatrix P;
   StateAt(fix.stamp, &x, &P);
   const Eigen::Vector3d innovation = PoseInnovation(fix, x);
   const Eigen::Matrix3d S = P.topLeftCorner<3, 3>() + fix.covariance;
@@ -259,9 +268,10 @@ PoseEstimate Ekf::Estimate() const {
   PoseEstimate estimate;
   estimate.stamp = stamp_;
   estimate.pose = {x_(kX), x_(kY), x_(kYaw)};
-  estimate.linear_velocity = x_(kV);
+  estimate.linear_velocity = x_(kV) / (1.0 + x_(kScale));  // over the ground
   estimate.angular_velocity = x_(kW);
   estimate.gyro_bias = x_(kBias);
+  estimate.wheel_scale = x_(kScale);
   estimate.covariance = P_.topLeftCorner<3, 3>();
   return estimate;
 }
@@ -273,7 +283,7 @@ bool Ekf::CanApplyAt(double stamp) const {
   return stamp >= oldest_restorable;
 }
 
-void Ekf::StateAt(double stamp, Vector6* x, Matrix6* P) const {
+void Ekf::StateAt(double stamp, StateVector* x, StateMatrix* P) const {
   // Inputs at the same stamp count as before it.
   const auto later = std::upper_bound(history_.begin(), history_.end(), stamp,
                                       [](double t, const HistoryEntry& entry) { return t < entry.stamp; });
@@ -314,8 +324,8 @@ void Ekf::Process(double stamp, const Input& input) {
 
 void Ekf::Predict(double stamp) {
   if (stamp <= stamp_) return;
-  Vector6 x;
-  Matrix6 P;
+  StateVector x;
+  StateMatrix P;
   Propagate(x_, P_, stamp - stamp_, parameters_, &x, &P);
   x_ = x;
   P_ = P;
@@ -334,15 +344,17 @@ bool Ekf::Apply(const Input& input) {
 }
 
 bool Ekf::UpdateWheelSpeeds(const WheelSpeedMeasurement& m) {
-  // Per wheel: a fixed sigma (encoder quantization over one period) plus a slip fraction of the
-  // wheel's speed. The faster wheel turns at |v| + |w| * separation / 2; a wheel speed error
-  // becomes a turn rate error through 2 / separation.
+  // The wheels measure their own speeds (v, w); the slip state scales v into the ground's motion
+  // (PropagateMotion), so only the position fixes observe it - the wheels cannot tell slip from
+  // speed. Per wheel, a fixed sigma (encoder quantization over one period) plus a slip fraction of
+  // the wheel's speed for the slip's fast part. The faster wheel turns at |v| + |w| * separation /
+  // 2; a wheel speed error becomes a turn rate error through 2 / separation.
   const double half_separation = 0.5 * geometry_.wheel_separation;
   const double linear_sigma = parameters_.wheel_speed_sigma + parameters_.wheel_slip_fraction * std::abs(m.linear);
   const double fastest_wheel = std::abs(m.linear) + half_separation * std::abs(m.angular);
   const double angular_sigma =
       (parameters_.wheel_speed_sigma + parameters_.wheel_slip_fraction * fastest_wheel) / half_separation;
-  Eigen::Matrix<double, 2, 6> H = Eigen::Matrix<double, 2, 6>::Zero();
+  Eigen::Matrix<double, 2, kN> H = Eigen::Matrix<double, 2, kN>::Zero();
   H(0, kV) = 1.0;
   H(1, kW) = 1.0;
   const Eigen::Vector2d innovation(m.linear - x_(kV), m.angular - x_(kW));
@@ -352,7 +364,7 @@ bool Ekf::UpdateWheelSpeeds(const WheelSpeedMeasurement& m) {
 
 bool Ekf::UpdateGyro(double rate) {
   // The gyro measures the true rate plus its bias.
-  Eigen::Matrix<double, 1, 6> H = Eigen::Matrix<double, 1, 6>::Zero();
+  Eigen::Matrix<double, 1, kN> H = Eigen::Matrix<double, 1, kN>::Zero();
   H(0, kW) = 1.0;
   H(0, kBias) = 1.0;
   const Eigen::Matrix<double, 1, 1> innovation(rate - x_(kW) - x_(kBias));

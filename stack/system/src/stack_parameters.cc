@@ -51,6 +51,8 @@ void ReadEkf(Reader& r, EkfParameters& p) {
   r.Number("gyro_bias_random_walk", &p.gyro_bias_random_walk, 0.0, 1.0, "rad/s^2/sqrt(Hz)");
   r.Number("wheel_speed_sigma", &p.wheel_speed_sigma, 1e-6, 10.0, "m/s");
   r.Number("wheel_slip_fraction", &p.wheel_slip_fraction, 0.0, 1.0);
+  r.Number("wheel_scale_sigma", &p.wheel_scale_sigma, 1e-6, 1.0);
+  r.Number("wheel_scale_random_walk", &p.wheel_scale_random_walk, 0.0, 1.0, "1/sqrt(s)");
   r.Number("gyro_sigma", &p.gyro_sigma, 1e-6, 10.0, "rad/s");
   r.Number("fix_gate_chi2", &p.fix_gate_chi2, 0.0, 1e6);  // 1e6: every fix passes
   r.Integer("relocalize_after_rejections", &p.relocalize_after_rejections, 1, 1000);
