@@ -63,12 +63,7 @@ SimulatedPoseFixParameters ReadSimulatedPoseFixes(const YamlMap& map) {
 Survey ReadSurvey(const YamlMap& map, std::uint64_t scenario_seed) {
   Survey survey;
   survey.point_sigma = map.NumberOr("point_sigma", survey.point_sigma, 0.0, 1.0, "m");
-  survey.seed = scenario_seed;
-  if (map.Has("seed")) {
-    const int seed = map.Int("seed", 1);
-    if (seed < 0) map.Fail("seed", "must not be negative");
-    survey.seed = static_cast<std::uint64_t>(seed);
-  }
+  survey.seed = ReadSeed(map, scenario_seed);
   survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
   if (map.Has("unmapped")) {
     survey.unmapped = map.Integers("unmapped", 1, garden::kMaxGardenObjectId);

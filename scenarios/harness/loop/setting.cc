@@ -25,12 +25,15 @@ Setting Setting::Read(const YamlMap& root, bool with_seed) {
   setting.start.yaw = start.NumberOr("yaw_deg", 0.0, -360.0, 360.0, "deg") * M_PI / 180.0;
   start.RejectUnknownKeys();
   if (root.Has("conditions")) setting.conditions = garden::Conditions::FromYaml(root.Map("conditions"));
-  if (with_seed) {
-    const int seed = root.Int("seed", 1);
-    if (seed < 0) root.Fail("seed", "must not be negative");
-    setting.seed = static_cast<std::uint64_t>(seed);
-  }
+  if (with_seed) setting.seed = ReadSeed(root, 1);
   return setting;
+}
+
+std::uint64_t ReadSeed(const YamlMap& map, std::uint64_t fallback) {
+  if (!map.Has("seed")) return fallback;
+  const int seed = map.Int("seed");
+  if (seed < 0) map.Fail("seed", "must not be negative");
+  return static_cast<std::uint64_t>(seed);
 }
 
 std::string ResolveGarden(const Setting& setting, const ProjectPaths& paths) {

@@ -37,6 +37,10 @@ struct Setting {
   static Setting Read(const YamlMap& root, bool with_seed);
 };
 
+// A `seed:` key of `map`: a whole number, not negative (InputError naming the file otherwise);
+// `fallback` when the key is absent.
+std::uint64_t ReadSeed(const YamlMap& map, std::uint64_t fallback);
+
 // The garden file of `setting`; an unknown garden is an error naming the scenario or plan's key.
 std::string ResolveGarden(const Setting& setting, const ProjectPaths& paths);
 // The garden of `setting`, read from its file.
