@@ -39,6 +39,7 @@ class MapCacheKeyTest : public ::testing::Test {
     fs::copy(testing::SourcePath("garden_scenes/gardens"), root_ + "/garden_scenes/gardens",
              fs::copy_options::recursive);
     fs::copy(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"), root_ + "/plan.yaml");
+    recipe_ = MapRecipe{};
     recipe_.plan_path = root_ + "/plan.yaml";
     recipe_.descriptor = visual_localization::Descriptor::kUprightSift;
     paths_ = {root_};
@@ -102,6 +103,12 @@ TEST_F(MapCacheKeyTest, EveryInputOfTheMapChangesTheKey) {
   EXPECT_TRUE(KeyChangesWith([&] { recipe_.survey_position_sigma = 0.05; }));
   SetUp();
   EXPECT_TRUE(KeyChangesWith([&] { recipe_.survey_rotation_sigma_deg = 1.0; }));
+  SetUp();
+  EXPECT_TRUE(KeyChangesWith([&] { recipe_.builder = visual_localization::KeyframePoses::kSurveyed; }));
+  SetUp();
+  // The log builder's odometry runs the stack's EKF.
+  EXPECT_TRUE(
+      KeyChangesWith([&] { Edit(root_ + "/robot/config/stack.yaml", "gyro_sigma: 0.005", "gyro_sigma: 0.006"); }));
   SetUp();
   EXPECT_TRUE(KeyChangesWith([&] { Edit(root_ + "/plan.yaml", "garden: test_lawn", "garden: wageningen"); }));
 }

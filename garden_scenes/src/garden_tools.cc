@@ -329,11 +329,9 @@ void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const st
   WriteFileAtomically(dir + "/" + name + ".yaml", yaml.str());
 }
 
-void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2, const std::string& path) {
+std::vector<SurfaceSample> SampleSurfaces(const Garden& garden, double growth, double points_per_m2) {
   Rng rng = MakeRng(garden.appearance_seed, "ground_truth_ply");
-  std::ostringstream body;
-  body << std::setprecision(6);
-  long count = 0;
+  std::vector<SurfaceSample> samples;
   auto sample_mesh = [&](const Mesh& mesh, const Eigen::Matrix4d& pose, ObjectClass c, int id) {
     for (const auto& f : mesh.faces) {
       const Eigen::Vector3d a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], d = mesh.vertices[f[2]];
@@ -345,9 +343,7 @@ void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_
         double u = UniformUnit(rng), v = UniformUnit(rng);
         if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
         const Eigen::Vector3d local = a + u * (b - a) + v * (d - a);
-        const Eigen::Vector3d p = (pose * local.homogeneous()).head<3>();
-        body << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << static_cast<int>(c) << ' ' << id << '\n';
-        ++count;
+        samples.push_back({(pose * local.homogeneous()).head<3>(), c, id});
       }
     }
   };
@@ -359,12 +355,20 @@ void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_
   for (const auto& object : garden.objects) {
     sample_mesh(ObjectMesh(object, garden.appearance_seed, growth), ObjectPose(object), object.object_class, object.id);
   }
+  return samples;
+}
+
+void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2, const std::string& path) {
+  const std::vector<SurfaceSample> samples = SampleSurfaces(garden, growth, points_per_m2);
   std::ostringstream ply;
-  ply << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed " << garden.appearance_seed << " growth "
-      << growth << "\nelement vertex " << count
+  ply << std::setprecision(6) << "ply\nformat ascii 1.0\ncomment garden " << garden.name << " seed "
+      << garden.appearance_seed << " growth " << growth << "\nelement vertex " << samples.size()
       << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar class\nproperty ushort object\n"
-         "end_header\n"
-      << body.str();
+         "end_header\n";
+  for (const auto& s : samples) {
+    ply << s.position.x() << ' ' << s.position.y() << ' ' << s.position.z() << ' ' << static_cast<int>(s.object_class)
+        << ' ' << s.object << '\n';
+  }
   WriteFileAtomically(path, ply.str());
 }
 

@@ -85,14 +85,23 @@ void AddMapCommands(Commands& commands) {
       ->add_option("--survey-rotation-sigma-deg", options->recipe.survey_rotation_sigma_deg,
                    "survey rotation noise (deg)")
       ->check(CLI::Range(0.0, 10.0));
+  auto builder = std::make_shared<std::string>("log");
+  build->add_option("--builder", *builder,
+                    "log: from the robot's own odometry, loop closure and the surveyed outlines (default); "
+                    "surveyed: from survey poses (truth plus the survey sigmas)");
   auto descriptor = std::make_shared<std::string>();
   build->add_option("--descriptor", *descriptor,
                     "upright_sift or sift (default: stack.yaml's visual_localization.descriptor)");
-  commands.OnRun(build, [options, seed, seconds, seed_option, seconds_option, descriptor, &commands] {
+  commands.OnRun(build, [options, seed, seconds, seed_option, seconds_option, descriptor, builder, &commands] {
     try {
       if (!descriptor->empty()) options->recipe.descriptor = visual_localization::DescriptorFromString(*descriptor);
     } catch (const std::invalid_argument& e) {
       throw InputError("--descriptor", e.what());
+    }
+    try {
+      options->recipe.builder = visual_localization::KeyframePosesFromString(*builder);
+    } catch (const std::invalid_argument& e) {
+      throw InputError("--builder", e.what());
     }
     options->paths = commands.paths();
     if (seed_option->count() > 0) options->recipe.seed = *seed;

@@ -105,6 +105,13 @@ void ReadVisualMap(const YamlMap& root, Scenario& s) {
   recipe.plan_path = relative_to_scenario(spec.String("mapping_drive"));
   if (spec.Has("seed")) recipe.seed = static_cast<std::uint64_t>(spec.Integer("seed", 0, 2147483647));
   if (spec.Has("seconds")) recipe.seconds = spec.Number("seconds", 1e-3, 1e6, "s");
+  if (spec.Has("builder")) {
+    try {
+      recipe.builder = visual_localization::KeyframePosesFromString(spec.String("builder"));
+    } catch (const std::invalid_argument& e) {
+      spec.Fail("builder", e.what());
+    }
+  }
   recipe.survey_position_sigma = spec.NumberOr("survey_position_sigma", recipe.survey_position_sigma, 0.0, 1.0, "m");
   recipe.survey_rotation_sigma_deg =
       spec.NumberOr("survey_rotation_sigma_deg", recipe.survey_rotation_sigma_deg, 0.0, 10.0, "deg");

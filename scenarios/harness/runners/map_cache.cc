@@ -61,7 +61,10 @@ std::string Number(double value) {
 // Every setting of the map builder, so that a changed default rebuilds the maps made with it.
 std::string BuilderSettings(const visual_localization::MapBuilderOptions& o) {
   std::ostringstream out;
-  out << "descriptor " << visual_localization::ToString(o.features.descriptor) << "\n"
+  const visual_localization::OdometryFactorOptions& d = o.odometry;
+  const visual_localization::LoopClosureOptions& l = o.loops;
+  out << "builder " << visual_localization::ToString(o.poses) << "\n"
+      << "descriptor " << visual_localization::ToString(o.features.descriptor) << "\n"
       << "max_features " << o.features.max_features << "\n"
       << "keyframe_distance " << Number(o.keyframe_distance) << "\nkeyframe_angle " << Number(o.keyframe_angle) << "\n"
       << "match_next_keyframes " << o.match_next_keyframes << "\nmax_camera_angle " << Number(o.max_camera_angle)
@@ -74,6 +77,17 @@ std::string BuilderSettings(const visual_localization::MapBuilderOptions& o) {
       << "min_triangulation_angle " << Number(o.min_triangulation_angle) << "\nmax_depth " << Number(o.max_depth)
       << "\n"
       << "vocabulary_words " << o.vocabulary_words << "\nadjustment_iterations " << o.adjustment_iterations << "\n";
+  if (o.poses == visual_localization::KeyframePoses::kOdometry) {
+    out << "odometry_epipolar_angle " << Number(o.odometry_epipolar_angle) << "\nodometry " << Number(d.along_sigma)
+        << " " << Number(d.along_sigma_per_m) << " " << Number(d.lateral_sigma) << " " << Number(d.lateral_sigma_per_m)
+        << " " << Number(d.yaw_sigma) << " " << Number(d.yaw_sigma_per_rad) << " " << Number(d.height_sigma) << " "
+        << Number(d.tilt_sigma) << " " << Number(d.scale_stretch) << " " << Number(d.scale_prior_sigma) << " "
+        << Number(d.scale_change_sigma) << "\nloops " << Number(l.min_travel) << " " << Number(l.search_radius) << " "
+        << Number(l.search_radius_per_m) << " " << l.candidates << " " << l.min_inliers << " "
+        << Number(l.position_sigma) << " " << Number(l.rotation_sigma) << " " << Number(l.loss_scale) << "\ntie "
+        << Number(o.tie.min_height) << " " << Number(o.tie.start_distance) << " " << Number(o.tie.end_distance) << " "
+        << Number(o.tie.huber) << " " << o.tie.iterations << "\n";
+  }
   return out.str();
 }
 
@@ -168,6 +182,14 @@ std::string MapCacheKey(const MapRecipe& recipe, const ProjectPaths& paths) {
       << "urdf " << Hex(Fnv1a(ReadBytes(robot.urdf))) << "\n"
       << "camchain " << Hex(Fnv1a(YamlContent(robot.camchain))) << "\n"
       << "robot parameters " << Hex(Fnv1a(YamlContent(robot.robot_parameters))) << "\n";
+  // The log builder's odometry runs the stack's EKF (its gyro bias).
+  if (recipe.builder == visual_localization::KeyframePoses::kOdometry) {
+    const stack::EkfParameters e = stack::StackParameters::Load(robot.stack_parameters).ekf;
+    key << "odometry ekf " << Number(e.linear_acceleration_density) << " " << Number(e.angular_acceleration_density)
+        << " " << Number(e.gyro_bias_random_walk) << " " << Number(e.wheel_speed_sigma) << " "
+        << Number(e.wheel_slip_fraction) << " " << Number(e.wheel_scale_sigma) << " "
+        << Number(e.wheel_scale_random_walk) << " " << Number(e.gyro_sigma) << "\n";
+  }
   // A scenario as the mapping drive is driven by the stack: all of its parameters count then.
   if (plan.Has("goals")) key << "stack parameters " << Hex(Fnv1a(YamlContent(robot.stack_parameters))) << "\n";
   key << "seed " << (recipe.seed ? std::to_string(*recipe.seed) : "the plan's") << "\n"
@@ -224,7 +246,20 @@ std::optional<MapRecipe> VisualMapRecipe(const Scenario& scenario, const Project
 
 std::optional<CachedMap> ResolveVisualMap(Scenario& scenario, const ProjectPaths& paths, const std::string& cache_dir) {
   const std::optional<MapRecipe> recipe = VisualMapRecipe(scenario, paths);
-  if (!recipe) return std::nullopt;
+  if (!recipe) {
+    // A map file the scenario names must show the garden as this build renders it.
+    if (!scenario.visual_map.empty() &&
+        StackParametersFor(scenario, paths).localization == stack::LocalizationSource::kVisual) {
+      const int version = visual_localization::VisualMap::Load(scenario.visual_map).appearance_version;
+      if (version != garden::kTextureGeneratorVersion) {
+        throw InputError(scenario.visual_map, "the map shows the garden's appearance version " +
+                                                  std::to_string(version) + ", this build renders version " +
+                                                  std::to_string(garden::kTextureGeneratorVersion) +
+                                                  " (rebuild the map with `trimbot map build`)");
+      }
+    }
+    return std::nullopt;
+  }
   CachedMap map = EnsureCachedMap(*recipe, paths, cache_dir);
   scenario.visual_map = map.path;
   return map;

@@ -10,7 +10,9 @@
 #include <optional>
 #include <random>
 
+#include "evaluation/map_evaluation.h"
 #include "evaluation/trial_result.h"
+#include "evaluation/tum_trajectory.h"
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
 #include "loop/pilots.h"
@@ -23,7 +25,11 @@
 #include "trimbot/common/rotation.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/garden_tools.h"
+#include "trimbot/garden/textures.h"
+#include "trimbot/robot/robot_description.h"
 #include "trimbot/robot/robot_files.h"
+#include "trimbot/robot/robot_parameters.h"
+#include "trimbot/stack/inertial_odometry.h"
 #include "trimbot/stack/robot_stack.h"
 #include "trimbot/visual_localization/map_builder.h"
 
@@ -60,9 +66,9 @@ class SurveyPoses {
 };
 
 // Hands the rendered keyframes to the builder with their survey poses.
-class MapRecorder : public Observer {
+class SurveyRecorder : public Observer {
  public:
-  MapRecorder(visual_localization::MapBuilder& builder, SurveyPoses& survey) : builder_(builder), survey_(survey) {}
+  SurveyRecorder(visual_localization::MapBuilder& builder, SurveyPoses& survey) : builder_(builder), survey_(survey) {}
   void Observe(const StepView& step) override {
     if (step.sensors.ring) builder_.AddFrame(*step.sensors.ring, survey_.PoseAt(step.truth));
   }
@@ -70,6 +76,28 @@ class MapRecorder : public Observer {
  private:
   visual_localization::MapBuilder& builder_;
   SurveyPoses& survey_;
+};
+
+// The robot's own log: its IMU and wheels feed the wheel-inertial odometry, whose pose each
+// rendered keyframe gets. The true pose at each keyframe's stamp is recorded beside it for the
+// evaluation only; the builder never sees it.
+class LogRecorder : public Observer {
+ public:
+  LogRecorder(visual_localization::MapBuilder& builder, stack::InertialOdometry& odometry)
+      : builder_(builder), odometry_(odometry) {}
+  void Observe(const StepView& step) override {
+    for (const auto& imu : step.sensors.imu) odometry_.Add(imu);
+    for (const auto& ticks : step.sensors.wheel_ticks) odometry_.Add(ticks);
+    if (step.sensors.ring && builder_.AddFrame(*step.sensors.ring, ToIsometry(odometry_.pose()))) {
+      truth_.push_back({step.sensors.ring->stamp, step.truth.T_map_base});
+    }
+  }
+  const std::vector<StampedPose>& truth() const { return truth_; }
+
+ private:
+  visual_localization::MapBuilder& builder_;
+  stack::InertialOdometry& odometry_;
+  std::vector<StampedPose> truth_;  // evaluation only
 };
 
 // Mean position error (m) of the map's keyframes against the ground truth at their stamps.
@@ -85,6 +113,54 @@ nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const S
           {"adjusted_position_error_mean_m", ErrorStats::From(adjusted).mean}};
 }
 
+constexpr double kSurfaceSamplesPerM2 = 2500.0;  // 2 cm apart: the point error is resolved to ~1 cm
+
+// A log-built map against the truth: keyframes (and the odometry they started from), points
+// against the garden's true surfaces; TUM files of all three trajectories for evo.
+nlohmann::json EvaluateLogMap(const visual_localization::MapBuilder& builder, const visual_localization::VisualMap& map,
+                              const std::vector<StampedPose>& truth, const garden::Garden& garden, double growth,
+                              const std::string& out_dir) {
+  std::vector<StampedPose> estimate, odometry;
+  std::string tum_estimate, tum_odometry, tum_truth;
+  for (std::size_t k = 0; k < builder.keyframe_data().size(); ++k) {
+    const auto& keyframe = builder.keyframe_data()[k];
+    estimate.push_back({keyframe.stamp, keyframe.T_map_base});
+    odometry.push_back({keyframe.stamp, keyframe.T_prior});
+    tum_estimate += TumLine(keyframe.stamp, keyframe.T_map_base);
+    tum_odometry += TumLine(keyframe.stamp, keyframe.T_prior);
+    tum_truth += TumLine(truth[k].stamp, truth[k].T);
+  }
+  WriteFileAtomically(out_dir + "/keyframes.tum", tum_estimate);
+  WriteFileAtomically(out_dir + "/keyframes_odometry.tum", tum_odometry);
+  WriteFileAtomically(out_dir + "/keyframes_truth.tum", tum_truth);
+  std::string loops = "query,match,inliers,weight\n";
+  for (const auto& loop : builder.loops()) {
+    loops += std::to_string(loop.query) + "," + std::to_string(loop.match) + "," + std::to_string(loop.inliers) + "," +
+             std::to_string(loop.weight) + "\n";
+  }
+  WriteFileAtomically(out_dir + "/loops.csv", loops);
+  std::vector<Eigen::Vector3d> surface;
+  for (const auto& sample : garden::SampleSurfaces(garden, growth, kSurfaceSamplesPerM2))
+    surface.push_back(sample.position);
+  return {{"keyframes", TrajectoryErrors(estimate, truth)},
+          {"odometry", TrajectoryErrors(odometry, truth)},
+          {"points_to_true_surfaces_m", PointErrors(map.points, surface)}};
+}
+
+// The surveyed objects as shapes, for the tie of a log-built map to the garden.
+std::vector<visual_localization::SurveyedShape> SurveyedShapes(const garden::Garden& surveyed) {
+  using Kind = visual_localization::SurveyedShape::Kind;
+  std::vector<visual_localization::SurveyedShape> shapes;
+  for (const auto& object : surveyed.objects) {
+    const Kind kind = object.shape == garden::Shape::kBox        ? Kind::kBox
+                      : object.shape == garden::Shape::kCylinder ? Kind::kCylinder
+                                                                 : Kind::kEllipsoid;
+    const Eigen::Vector3d centre(object.position.x(), object.position.y(), object.base_height + object.size.z() / 2);
+    shapes.push_back({kind, centre, object.size, object.yaw});
+  }
+  return shapes;
+}
+
 constexpr std::uint64_t kMappingSeedOffset = 1000;  // a scenario's mapping drive: other noise than its trials
 
 // The mapping drive: a drive plan played open loop, or a scenario whose goals the robot drives to
@@ -98,6 +174,10 @@ struct MappingDrive {
   std::unique_ptr<Pilot> pilot;
   std::optional<SimulatedPoseFixes> fixes;
   visual_localization::Descriptor descriptor;  // the stack's, whose localizer will use the map
+  stack::EkfParameters ekf;                    // the stack's, for the log builder's odometry
+  Pose2
+      believed_start;  // where the robot is believed to start: the plan's start as stated, a scenario's with its error
+  garden::Garden surveyed;  // the garden as the user surveyed it (its errors included)
 };
 
 std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
@@ -110,6 +190,11 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
     if (options.recipe.seed) drive->setting.seed = *options.recipe.seed;
     drive->duration = std::min(drive->plan->duration(), options.recipe.seconds.value_or(drive->plan->duration()));
     drive->pilot = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
+    drive->ekf = parameters.ekf;
+    drive->believed_start = drive->setting.start;
+    Survey survey;
+    survey.seed = drive->setting.seed;
+    drive->surveyed = SurveyedGarden(LoadGarden(drive->setting, options.paths), survey, options.recipe.plan_path);
     return drive;
   }
   drive->scenario = Scenario::Load(options.recipe.plan_path);
@@ -123,16 +208,64 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
     parameters.localization = stack::LocalizationSource::kSimulatedPoseFixes;
   }
   drive->robot = std::make_unique<stack::RobotStack>(options.paths.robot_files(), parameters, drive->setting.seed);
-  drive->robot->SetInitialPose(0.0, scenario.setting.start);
-  const garden::Garden surveyed =
-      SurveyedGarden(LoadGarden(scenario.setting, options.paths), scenario.survey, scenario.source);
-  drive->robot->SetMap(WritePriorMap(PriorMap(scenario, surveyed), options.out_dir + "/prior_map"));
-  drive->robot->SetGoals(MissionGoals(scenario, surveyed));
+  drive->ekf = parameters.ekf;
+  drive->believed_start = BelievedStart(scenario, drive->setting.seed);
+  drive->robot->SetInitialPose(0.0, drive->believed_start);
+  drive->surveyed = SurveyedGarden(LoadGarden(scenario.setting, options.paths), scenario.survey, scenario.source);
+  drive->robot->SetMap(WritePriorMap(PriorMap(scenario, drive->surveyed), options.out_dir + "/prior_map"));
+  drive->robot->SetGoals(MissionGoals(scenario, drive->surveyed));
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     drive->fixes.emplace(scenario.simulated_pose_fixes, drive->setting.seed);
   }
   drive->pilot = std::make_unique<StackPilot>(*drive->robot);
   return drive;
+}
+
+// The build's figures (map_stats.json); `drive_seconds` includes the features' extraction.
+nlohmann::json MapStats(const std::string& plan_path, std::uint64_t seed, const char* builder,
+                        const visual_localization::VisualMap& map, const visual_localization::MapBuildStats& stats,
+                        double drive_seconds, double total_seconds) {
+  return {{"plan", plan_path},
+          {"garden", map.garden},
+          {"seed", seed},
+          {"descriptor", visual_localization::ToString(map.descriptor)},
+          {"builder", builder},
+          {"frames_seen", stats.frames},
+          {"keyframes", stats.keyframes},
+          {"images_matched", stats.images_matched},
+          {"matches", stats.matches},
+          {"tracks", stats.tracks},
+          {"points", stats.points},
+          {"observations", stats.observations},
+          {"outlier_observations_dropped", stats.outlier_observations},
+          {"mean_track_length", stats.mean_track_length},
+          {"gaps", {{"count", stats.gaps.size()}, {"keyframes", stats.gaps}}},
+          {"reprojection_rmse_px", stats.reprojection_rmse_px},
+          {"seconds",
+           {{"drive_and_render", drive_seconds - stats.seconds_features},
+            {"features", stats.seconds_features},
+            {"matching", stats.seconds_matching},
+            {"loops", stats.seconds_loops},
+            {"adjustment", stats.seconds_adjustment},
+            {"vocabulary", stats.seconds_vocabulary},
+            {"total", total_seconds}}}};
+}
+
+// The log builder's own figures: stereo, loops, wheel scales, the tie to the surveyed garden.
+nlohmann::json LogBuildStats(const visual_localization::MapBuildStats& stats, std::size_t loops_found) {
+  return {{"stereo_matches", stats.stereo_matches},
+          {"loops_tried", stats.loops_tried},
+          {"loops_found", loops_found},
+          {"loops_accepted", stats.loops_accepted},
+          {"wheel_scale_stretches", stats.scale_stretches},
+          {"wheel_scale_min", stats.scale_min},
+          {"wheel_scale_max", stats.scale_max},
+          {"tie_points", stats.tie_points},
+          {"tie_residual_median_m", stats.tie_residual_median},
+          {"tie_correction",
+           {{"x_m", stats.tie_correction.x()},
+            {"y_m", stats.tie_correction.y()},
+            {"yaw_deg", stats.tie_correction.z() * 180 / M_PI}}}};
 }
 
 }  // namespace
@@ -143,6 +276,7 @@ visual_localization::MapBuilderOptions MapBuilderOptionsFor(const MapRecipe& rec
   options.survey_position_sigma = recipe.survey_position_sigma;
   options.survey_rotation_sigma = recipe.survey_rotation_sigma_deg * M_PI / 180.0;
   options.features.descriptor = descriptor;
+  options.poses = recipe.builder;
   return options;
 }
 
@@ -161,13 +295,24 @@ int RunMapBuild(const MapBuildOptions& options) {
   const visual_localization::MapBuilderOptions builder_options =
       MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(drive->descriptor));
   visual_localization::MapBuilder builder(rig, builder_options);
+  const bool from_log = builder_options.poses == visual_localization::KeyframePoses::kOdometry;
   SurveyPoses survey(setting.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
+  const robot::RobotDescription description = robot::RobotDescription::Load(options.paths.robot_files().urdf);
+  stack::InertialOdometry odometry(
+      drive->ekf, description.drive(),
+      robot::RobotParameters::Load(options.paths.robot_files().robot_parameters).wheel_encoders.ticks_per_revolution,
+      0.0, drive->believed_start);
+  if (from_log) builder.SetSurveyedShapes(SurveyedShapes(drive->surveyed));
+  SurveyRecorder survey_recorder(builder, survey);
+  LogRecorder log_recorder(builder, odometry);
+  Observer& recorder = from_log ? static_cast<Observer&>(log_recorder) : survey_recorder;
 
-  MapRecorder recorder(builder, survey);
   LoopOptions loop;
   loop.time_limit = drive->duration;
   loop.render_on_demand = true;
-  loop.ring_demand = [&](const sim::GroundTruth& truth) { return builder.WantsFrame(survey.PoseAt(truth)); };
+  loop.ring_demand = [&](const sim::GroundTruth& truth) {
+    return from_log ? builder.WantsFrame(ToIsometry(odometry.pose())) : builder.WantsFrame(survey.PoseAt(truth));
+  };
   loop.pose_fixes = drive->fixes ? &*drive->fixes : nullptr;
   // Progress every 10 simulated seconds: a mapping drive renders for minutes.
   loop.progress = [&](double t) {
@@ -185,7 +330,8 @@ int RunMapBuild(const MapBuildOptions& options) {
   std::cout << "[map] drive done, " << builder.keyframes() << " keyframes in " << static_cast<int>(drive_seconds)
             << " s; features, matching, bundle adjustment..." << std::endl;
   visual_localization::MapBuildStats stats;
-  const visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
+  visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
+  map.appearance_version = garden::kTextureGeneratorVersion;
   if (map.points.empty()) {
     throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" +
                              std::to_string(stats.keyframes) + " keyframes; too short, or nothing textured in view)");
@@ -196,28 +342,18 @@ int RunMapBuild(const MapBuildOptions& options) {
                   "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
                       std::to_string(stats.keyframes) + " keyframes");
   const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  nlohmann::json report = {{"plan", options.recipe.plan_path},
-                           {"garden", map.garden},
-                           {"seed", setting.seed},
-                           {"descriptor", visual_localization::ToString(map.descriptor)},
-                           {"frames_seen", stats.frames},
-                           {"keyframes", stats.keyframes},
-                           {"images_matched", stats.images_matched},
-                           {"matches", stats.matches},
-                           {"tracks", stats.tracks},
-                           {"points", stats.points},
-                           {"observations", stats.observations},
-                           {"outlier_observations_dropped", stats.outlier_observations},
-                           {"mean_track_length", stats.mean_track_length},
-                           {"reprojection_rmse_px", stats.reprojection_rmse_px},
-                           {"seconds",
-                            {{"drive_and_render", drive_seconds - stats.seconds_features},
-                             {"features", stats.seconds_features},
-                             {"matching", stats.seconds_matching},
-                             {"adjustment", stats.seconds_adjustment},
-                             {"vocabulary", stats.seconds_vocabulary},
-                             {"total", total_seconds}}},
-                           {"keyframes_against_ground_truth", KeyframeErrors(map, survey)}};
+  nlohmann::json report =
+      MapStats(options.recipe.plan_path, setting.seed, visual_localization::ToString(builder_options.poses), map, stats,
+               drive_seconds, total_seconds);
+  if (from_log) {
+    report["log"] = LogBuildStats(stats, builder.loops().size());
+    const auto evaluation_start = Clock::now();
+    report["evaluation"] = EvaluateLogMap(builder, map, log_recorder.truth(), simulator.garden(),
+                                          setting.conditions.growth, options.out_dir);
+    report["seconds"]["evaluation"] = std::chrono::duration<double>(Clock::now() - evaluation_start).count();
+  } else {
+    report["keyframes_against_ground_truth"] = KeyframeErrors(map, survey);
+  }
   WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
   std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "
             << stats.mean_track_length << ", reprojection RMSE " << stats.reprojection_rmse_px << " px, "

@@ -1,13 +1,19 @@
 #pragma once
 // `trimbot map build`: a mapping drive - a drive plan played open loop, or a scenario whose goals
 // the robot's stack drives to (on the simulated pose fixes or dead reckoning, as the map does not
-// exist yet; with a seed 1000 above the scenario's) - rendered only where the map builder takes a
-// keyframe, with survey poses = ground truth + seeded noise (as the real map was tied to a laser
-// tracker), through the stack's MapBuilder into one map file. Writes into the output folder:
+// exist yet; with a seed 1000 above the scenario's, from its believed start) - rendered only where
+// the map builder takes a keyframe, through the stack's MapBuilder into one map file. The log
+// builder (default) gets the robot's IMU and wheel ticks (its odometry places the keyframes) and
+// the garden as surveyed (with the survey's errors, for the tie); the surveyed builder gets survey
+// poses = ground truth + seeded noise. The truth at each keyframe goes to the evaluation only.
+// Writes into the output folder:
 //   map.sqlite        the map (VisualMap)
 //   map_stats.json    keyframes, points, observations, mean track length, reprojection RMSE, time
-//                     per stage, keyframe pose errors against ground truth (survey and adjusted)
+//                     per stage; log: stereo, loops, wheel scales, the tie, and the evaluation
+//                     (keyframe ATE unaligned and SE(3)-aligned, RPE, the odometry's, map points
+//                     against the true surfaces); surveyed: keyframe errors (survey and adjusted)
 //   map_top_view.png  points over the garden, keyframe poses
+//   keyframes.tum, keyframes_odometry.tum, keyframes_truth.tum, loops.csv   (log)
 #include <cstdint>
 #include <optional>
 #include <string>

@@ -1,7 +1,5 @@
 #include "trimbot/visual_localization/map_builder.h"
 
-#include <ceres/ceres.h>
-#include <ceres/rotation.h>
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
@@ -13,20 +11,26 @@
 #include <numeric>
 #include <optional>
 
+#include "map_adjustment.h"
 #include "trimbot/common/rotation.h"
+#include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::visual_localization {
 namespace {
+
+using mapping::Adjust;
+using mapping::FeatureRef;
+using mapping::MakeWheelScales;
+using mapping::OptimizePoseGraph;
+using mapping::PointTrack;
+using mapping::TieToShapes;
+using mapping::Track;
+using mapping::WheelScales;
 
 using Clock = std::chrono::steady_clock;
 double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 double RotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
-
-// One feature of one image of one keyframe.
-struct FeatureRef {
-  int keyframe = 0, camera = 0, feature = 0;
-};
 
 class UnionFind {
  public:
@@ -44,110 +48,89 @@ class UnionFind {
   std::vector<std::size_t> parent_;
 };
 
-// Observed normalized image point vs the projection of a map point, in pixels / sigma.
-struct ReprojectionError {
-  Eigen::Vector2d observed;  // normalized (x/z, y/z) in the camera
-  Eigen::Matrix3d R_cam_base;
-  Eigen::Vector3d t_cam_base;
-  double scale;  // focal length / pixel sigma
-
-  template <typename T>
-  bool operator()(const T* const pose, const T* const point, T* residual) const {
-    // pose: angle-axis of R_map_base (3), translation of base_link in the map (3).
-    T p[3] = {point[0] - pose[3], point[1] - pose[4], point[2] - pose[5]};
-    T inverse[3] = {-pose[0], -pose[1], -pose[2]};
-    T in_base[3];
-    ceres::AngleAxisRotatePoint(inverse, p, in_base);
-    Eigen::Matrix<T, 3, 1> in_camera =
-        R_cam_base.cast<T>() * Eigen::Matrix<T, 3, 1>(in_base[0], in_base[1], in_base[2]) + t_cam_base.cast<T>();
-    if (in_camera(2) < T(1e-3)) in_camera(2) = T(1e-3);
-    residual[0] = T(scale) * (in_camera(0) / in_camera(2) - T(observed.x()));
-    residual[1] = T(scale) * (in_camera(1) / in_camera(2) - T(observed.y()));
-    return true;
-  }
-};
-
-// The survey's pose of a keyframe as a soft constraint.
-struct PosePrior {
-  Eigen::Matrix3d R_prior_transposed;
-  Eigen::Vector3d t_prior;
-  double rotation_sigma, position_sigma;
-
-  template <typename T>
-  bool operator()(const T* const pose, T* residual) const {
-    T R[9];
-    ceres::AngleAxisToRotationMatrix(pose, R);  // column-major
-    Eigen::Map<const Eigen::Matrix<T, 3, 3>> R_map_base(R);
-    const Eigen::Matrix<T, 3, 3> delta = R_prior_transposed.cast<T>() * R_map_base;
-    T delta_cm[9];
-    Eigen::Map<Eigen::Matrix<T, 3, 3>> delta_map(delta_cm);
-    delta_map = delta;
-    T angle_axis[3];
-    ceres::RotationMatrixToAngleAxis(delta_cm, angle_axis);
-    for (int i = 0; i < 3; ++i) {
-      residual[i] = angle_axis[i] / T(rotation_sigma);
-      residual[3 + i] = (pose[3 + i] - T(t_prior(i))) / T(position_sigma);
-    }
-    return true;
-  }
-};
-
 // ---- matching ----------------------------------------------------------------------------------
 
 struct ImageMatch {
   FeatureRef a, b;
 };
 
-// Matches of image (ka, ca) with image (kb, cb): ratio test, then the epipolar angle of the
-// survey poses (the rays must lie near the plane through both camera centres).
+Eigen::Isometry3d CameraPose(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig, int k, int c) {
+  return keyframes[static_cast<std::size_t>(k)].T_map_base * rig.camera(c).T_base_camera;
+}
+
+// How far (rad) the ray of b lies from the epipolar plane through both camera centres and the ray
+// of a, at the keyframes' present poses.
+double EpipolarAngle(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig, const ImageMatch& m) {
+  const Eigen::Isometry3d Ta = CameraPose(keyframes, rig, m.a.keyframe, m.a.camera);
+  const Eigen::Isometry3d Tb = CameraPose(keyframes, rig, m.b.keyframe, m.b.camera);
+  const Eigen::Vector3d ra = Ta.linear() * keyframes[m.a.keyframe].images[m.a.camera].bearings[m.a.feature];
+  const Eigen::Vector3d rb = Tb.linear() * keyframes[m.b.keyframe].images[m.b.camera].bearings[m.b.feature];
+  const Eigen::Vector3d normal = (Tb.translation() - Ta.translation()).cross(ra);
+  if (normal.norm() < 1e-12) return M_PI;
+  return std::abs(std::asin(std::clamp(normal.normalized().dot(rb), -1.0, 1.0)));
+}
+
+// Matches of image (ka, ca) with image (kb, cb): ratio test, then the epipolar angle (the rays
+// must lie near the plane through both camera centres). Image pairs closer than `min_baseline`
+// are skipped (no parallax), except the two cameras of a stereo pair, whose baseline is calibrated.
 void MatchImages(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig, int ka, int ca, int kb,
-                 int cb, const MapBuilderOptions& options, std::vector<ImageMatch>* matches) {
+                 int cb, double ratio, double epipolar_angle, double min_baseline, std::vector<ImageMatch>* matches) {
   const MappingImage& A = keyframes[ka].images[ca];
   const MappingImage& B = keyframes[kb].images[cb];
   if (A.descriptors.rows < 2 || B.descriptors.rows < 2) return;
-  const Eigen::Isometry3d Ta = keyframes[ka].T_map_base * rig.camera(ca).T_base_camera;
-  const Eigen::Isometry3d Tb = keyframes[kb].T_map_base * rig.camera(cb).T_base_camera;
-  const Eigen::Vector3d baseline = Tb.translation() - Ta.translation();
-  if (baseline.norm() < 0.05) return;  // no parallax to triangulate from
+  const double baseline =
+      (CameraPose(keyframes, rig, kb, cb).translation() - CameraPose(keyframes, rig, ka, ca).translation()).norm();
+  if (baseline < min_baseline) return;
   cv::FlannBasedMatcher matcher(cv::makePtr<cv::flann::KDTreeIndexParams>(4), cv::makePtr<cv::flann::SearchParams>(32));
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(A.descriptors, B.descriptors, knn, 2);
   for (const auto& pair : knn) {
-    if (pair.size() < 2 || pair[0].distance > options.ratio * pair[1].distance) continue;
-    const Eigen::Vector3d ra = Ta.linear() * A.bearings[pair[0].queryIdx];
-    const Eigen::Vector3d rb = Tb.linear() * B.bearings[pair[0].trainIdx];
-    const Eigen::Vector3d normal = baseline.cross(ra);
-    if (normal.norm() < 1e-9) continue;
-    if (std::abs(std::asin(std::clamp(normal.normalized().dot(rb), -1.0, 1.0))) > options.epipolar_angle) continue;
-    matches->push_back({{ka, ca, pair[0].queryIdx}, {kb, cb, pair[0].trainIdx}});
+    if (pair.size() < 2 || pair[0].distance > ratio * pair[1].distance) continue;
+    const ImageMatch m{{ka, ca, pair[0].queryIdx}, {kb, cb, pair[0].trainIdx}};
+    if (EpipolarAngle(keyframes, rig, m) <= epipolar_angle) matches->push_back(m);
   }
 }
 
+// Every image pair of two keyframes whose optical axes are within `max_camera_angle`.
+void MatchKeyframePair(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig, int ka, int kb,
+                       double epipolar_angle, const MapBuilderOptions& options, MapBuildStats* stats,
+                       std::vector<ImageMatch>* matches) {
+  for (int ca = 0; ca < rig.size(); ++ca) {
+    for (int cb = 0; cb < rig.size(); ++cb) {
+      const Eigen::Vector3d axis_a = CameraPose(keyframes, rig, ka, ca).linear().col(2);
+      const Eigen::Vector3d axis_b = CameraPose(keyframes, rig, kb, cb).linear().col(2);
+      if (std::acos(std::clamp(axis_a.dot(axis_b), -1.0, 1.0)) > options.max_camera_angle) continue;
+      MatchImages(keyframes, rig, ka, ca, kb, cb, options.ratio, epipolar_angle, 0.05, matches);
+      ++stats->images_matched;
+    }
+  }
+}
+
+// Each keyframe with the next few (and, from the odometry, the two cameras of each stereo pair
+// within it).
 std::vector<ImageMatch> MatchKeyframes(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig,
-                                       const MapBuilderOptions& options, MapBuildStats* stats) {
+                                       double epipolar_angle, const MapBuilderOptions& options, MapBuildStats* stats) {
   std::srand(1);  // FLANN's randomized trees draw from rand(): the same map from the same drive
   std::vector<ImageMatch> matches;
   const int n = static_cast<int>(keyframes.size());
   for (int ka = 0; ka < n; ++ka) {
-    for (int kb = ka + 1; kb < n && kb <= ka + options.match_next_keyframes; ++kb) {
-      for (int ca = 0; ca < rig.size(); ++ca) {
-        for (int cb = 0; cb < rig.size(); ++cb) {
-          const Eigen::Vector3d axis_a = (keyframes[ka].T_map_base * rig.camera(ca).T_base_camera).linear().col(2);
-          const Eigen::Vector3d axis_b = (keyframes[kb].T_map_base * rig.camera(cb).T_base_camera).linear().col(2);
-          if (std::acos(std::clamp(axis_a.dot(axis_b), -1.0, 1.0)) > options.max_camera_angle) continue;
-          MatchImages(keyframes, rig, ka, ca, kb, cb, options, &matches);
-          ++stats->images_matched;
-        }
+    if (options.poses == KeyframePoses::kOdometry) {
+      for (const auto& pair : rig.StereoPairs()) {
+        const std::size_t before = matches.size();
+        MatchImages(keyframes, rig, ka, pair.left, ka, pair.right, options.ratio, options.epipolar_angle, 0.0,
+                    &matches);
+        stats->stereo_matches += static_cast<int>(matches.size() - before);
+        ++stats->images_matched;
       }
     }
+    for (int kb = ka + 1; kb < n && kb <= ka + options.match_next_keyframes; ++kb) {
+      MatchKeyframePair(keyframes, rig, ka, kb, epipolar_angle, options, stats, &matches);
+    }
   }
-  stats->matches = static_cast<int>(matches.size());
   return matches;
 }
 
 // ---- tracks and points -------------------------------------------------------------------------
-
-using Track = std::vector<FeatureRef>;
 
 std::vector<Track> JoinTracks(const std::vector<MappingKeyframe>& keyframes, const std::vector<ImageMatch>& matches) {
   // A global index for every feature of every image.
@@ -185,9 +168,10 @@ std::vector<Track> JoinTracks(const std::vector<MappingKeyframe>& keyframes, con
   return tracks;
 }
 
-// Midpoint triangulation from the survey poses; nullopt when the rays do not make a good point.
+// Midpoint triangulation from the keyframes' present poses; nullopt when the rays do not make a
+// good point (too parallel, behind or too far, or a ray further than `max_ray_angle` off it).
 std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig,
-                                           const Track& track, const MapBuilderOptions& options) {
+                                           const Track& track, const MapBuilderOptions& options, double max_ray_angle) {
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> rays;
@@ -212,75 +196,11 @@ std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& k
     const Eigen::Vector3d in_camera = cameras[i].inverse() * X;
     if (in_camera.z() < 0.2 || in_camera.norm() > options.max_depth) return std::nullopt;
     if (std::acos(std::clamp(in_camera.normalized().dot(cameras[i].linear().transpose() * rays[i]), -1.0, 1.0)) >
-        4.0 * options.epipolar_angle) {
+        max_ray_angle) {
       return std::nullopt;
     }
   }
   return X;
-}
-
-// ---- adjustment --------------------------------------------------------------------------------
-
-struct PointTrack {
-  Eigen::Vector3d position;
-  Track track;
-};
-
-// Bundle adjustment of keyframe poses and points, the poses held near `survey` (one per keyframe);
-// returns the RMS reprojection error in pixels and each observation's error (px; points in order,
-// each point's track in order) in `errors`.
-double Adjust(const robot::CameraRig& rig, const MapBuilderOptions& options,
-              const std::vector<Eigen::Isometry3d>& survey, std::vector<MappingKeyframe>& keyframes,
-              std::vector<PointTrack>& points, std::vector<double>* errors) {
-  std::vector<std::array<double, 6>> poses(keyframes.size());
-  for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const Eigen::AngleAxisd aa(keyframes[k].T_map_base.linear());
-    const Eigen::Vector3d w = aa.angle() * aa.axis(), t = keyframes[k].T_map_base.translation();
-    poses[k] = {w.x(), w.y(), w.z(), t.x(), t.y(), t.z()};
-  }
-  ceres::Problem problem;
-  std::vector<std::pair<ceres::ResidualBlockId, double>> blocks;  // with their pixel scale
-  for (auto& p : points) {
-    for (const auto& r : p.track) {
-      const robot::CameraCalibration& camera = rig.camera(r.camera);
-      const Eigen::Isometry3d T_cam_base = camera.T_base_camera.inverse();
-      const Eigen::Vector3d& bearing = keyframes[r.keyframe].images[r.camera].bearings[r.feature];
-      const double scale = camera.intrinsics.fx / options.pixel_sigma;
-      auto* cost = new ceres::AutoDiffCostFunction<ReprojectionError, 2, 6, 3>(
-          new ReprojectionError{bearing.head<2>() / bearing.z(), T_cam_base.linear(), T_cam_base.translation(), scale});
-      blocks.push_back(
-          {problem.AddResidualBlock(cost, new ceres::HuberLoss(2.0), poses[r.keyframe].data(), p.position.data()),
-           options.pixel_sigma});
-    }
-  }
-  for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    auto* prior = new ceres::AutoDiffCostFunction<PosePrior, 6, 6>(
-        new PosePrior{survey[k].linear().transpose(), survey[k].translation(), options.survey_rotation_sigma,
-                      options.survey_position_sigma});
-    problem.AddResidualBlock(prior, nullptr, poses[k].data());
-  }
-  ceres::Solver::Options solver;
-  solver.linear_solver_type = ceres::SPARSE_SCHUR;
-  solver.max_num_iterations = options.adjustment_iterations;
-  solver.num_threads = 1;  // one thread: the same map, bit for bit, from the same drive
-  ceres::Solver::Summary summary;
-  if (!blocks.empty()) ceres::Solve(solver, &problem, &summary);
-  for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const Eigen::Vector3d w(poses[k][0], poses[k][1], poses[k][2]);
-    keyframes[k].T_map_base.linear() = RotationFromVector(w);
-    keyframes[k].T_map_base.translation() << poses[k][3], poses[k][4], poses[k][5];
-  }
-  // RMS of the pixel residuals (the cost functions are scaled by 1/sigma).
-  double sum = 0.0;
-  errors->clear();
-  for (const auto& [id, sigma] : blocks) {
-    double residual[2];
-    problem.EvaluateResidualBlock(id, false, nullptr, residual, nullptr);
-    const double squared = (residual[0] * residual[0] + residual[1] * residual[1]) * sigma * sigma;
-    sum += squared;
-    errors->push_back(std::sqrt(squared));
-  }
-  return blocks.empty() ? 0.0 : std::sqrt(sum / (2.0 * blocks.size()));
 }
 
 // Drops observations with an error above `max_error` (px; `errors` as Adjust gives them), then
@@ -311,69 +231,45 @@ cv::Mat TrainVocabulary(const cv::Mat& descriptors, int words) {
   return centres;
 }
 
-}  // namespace
-
-MapBuilder::MapBuilder(const robot::CameraRig& rig, const MapBuilderOptions& options) : rig_(rig), options_(options) {}
-
-bool MapBuilder::WantsFrame(const Eigen::Isometry3d& T) const {
-  if (keyframes_.empty()) return true;
-  const Eigen::Isometry3d& last = keyframes_.back().T_map_base;
-  return (T.translation() - last.translation()).norm() >= options_.keyframe_distance ||
-         RotationAngle(last.linear().transpose() * T.linear()) >= options_.keyframe_angle;
-}
-
-bool MapBuilder::AddFrame(const messages::RingFrame& frame, const Eigen::Isometry3d& T_map_base_survey) {
-  ++stats_.frames;
-  if (!WantsFrame(T_map_base_survey)) return false;
-  const auto start = Clock::now();
-  MappingKeyframe keyframe;
-  keyframe.stamp = frame.stamp;
-  keyframe.T_map_base = T_map_base_survey;
-  keyframe.images.resize(static_cast<std::size_t>(rig_.size()));
-  for (const auto& image : frame.images) {
-    if (image.camera_index >= 0 && image.camera_index < rig_.size()) {
-      keyframe.images[static_cast<std::size_t>(image.camera_index)] =
-          ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
-    }
-  }
-  keyframes_.push_back(std::move(keyframe));
-  stats_.seconds_features += Since(start);
-  return true;
-}
-
-VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
-  auto start = Clock::now();
-  const std::vector<ImageMatch> matches = MatchKeyframes(keyframes_, rig_, options_, &stats_);
-  const std::vector<Track> tracks = JoinTracks(keyframes_, matches);
-  stats_.tracks = static_cast<int>(tracks.size());
+std::vector<PointTrack> TriangulateTracks(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig,
+                                          const std::vector<ImageMatch>& matches, const MapBuilderOptions& options,
+                                          double max_ray_angle, MapBuildStats* stats) {
+  const std::vector<Track> tracks = JoinTracks(keyframes, matches);
+  stats->tracks = static_cast<int>(tracks.size());
+  stats->matches = static_cast<int>(matches.size());
   std::vector<PointTrack> points;
   for (const auto& track : tracks) {
-    if (const auto X = Triangulate(keyframes_, rig_, track, options_)) points.push_back({*X, track});
+    if (const auto X = Triangulate(keyframes, rig, track, options, max_ray_angle)) points.push_back({*X, track});
   }
-  stats_.seconds_matching = Since(start);
-  start = Clock::now();
-  // Adjust, drop the observations the adjusted map cannot explain (wrong matches, silhouettes that
-  // move with the viewpoint), adjust again.
-  std::vector<Eigen::Isometry3d> survey;  // both passes are held to the survey, not the first pass
-  for (const auto& keyframe : keyframes_) survey.push_back(keyframe.T_map_base);
-  std::vector<double> errors;
-  Adjust(rig_, options_, survey, keyframes_, points, &errors);
-  stats_.outlier_observations = RemoveOutliers(errors, options_.max_reprojection_error, points);
-  stats_.reprojection_rmse_px = Adjust(rig_, options_, survey, keyframes_, points, &errors);
-  stats_.seconds_adjustment = Since(start);
+  return points;
+}
 
+// Adjust, drop the observations the adjusted map cannot explain (wrong matches, silhouettes that
+// move with the viewpoint), adjust again.
+void AdjustTwice(const robot::CameraRig& rig, const MapBuilderOptions& options, std::vector<MappingKeyframe>& keyframes,
+                 std::vector<PointTrack>& points, WheelScales& scales, MapBuildStats* stats) {
+  std::vector<double> errors;
+  Adjust(rig, options, keyframes, points, scales, &errors);
+  stats->outlier_observations = RemoveOutliers(errors, options.max_reprojection_error, points);
+  stats->reprojection_rmse_px = Adjust(rig, options, keyframes, points, scales, &errors);
+}
+
+// The map of these keyframes and points (each point's descriptor the mean of its track's).
+VisualMap MakeMap(const std::string& garden, const robot::CameraRig& rig, const MapBuilderOptions& options,
+                  const std::vector<MappingKeyframe>& keyframes, const std::vector<PointTrack>& points) {
   VisualMap map;
   map.garden = garden;
-  map.rig_signature = RigSignature(rig_);
-  map.descriptor = options_.features.descriptor;
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    map.keyframes.push_back({static_cast<int>(k), keyframes_[k].stamp, keyframes_[k].T_map_base});
+  map.rig_signature = RigSignature(rig);
+  map.descriptor = options.features.descriptor;
+  map.builder = ToString(options.poses);
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    map.keyframes.push_back({static_cast<int>(k), keyframes[k].stamp, keyframes[k].T_map_base});
   }
   std::vector<cv::Mat> descriptors;
   for (std::size_t i = 0; i < points.size(); ++i) {
     cv::Mat mean = cv::Mat::zeros(1, 128, CV_32F);
     for (const auto& r : points[i].track) {
-      const MappingImage& image = keyframes_[r.keyframe].images[r.camera];
+      const MappingImage& image = keyframes[r.keyframe].images[r.camera];
       mean += image.descriptors.row(r.feature);
       map.observations.push_back({r.keyframe, r.camera, static_cast<int>(i), image.pixels[r.feature]});
     }
@@ -381,8 +277,210 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
     map.points.push_back(points[i].position);
   }
   if (!descriptors.empty()) cv::vconcat(descriptors, map.descriptors);
+  if (!map.descriptors.empty()) map.vocabulary = TrainVocabulary(map.descriptors, options.vocabulary_words);
+  return map;
+}
+
+// The keyframe steps k-1 -> k whose keyframes share fewer than `min_shared` points.
+std::vector<int> FindGaps(std::size_t keyframes, const std::vector<PointTrack>& points, int min_shared) {
+  std::vector<int> shared(keyframes, 0);
+  for (const auto& p : points) {
+    std::vector<bool> seen(keyframes, false);
+    for (const auto& r : p.track) seen[static_cast<std::size_t>(r.keyframe)] = true;
+    for (std::size_t k = 1; k < keyframes; ++k) shared[k] += seen[k - 1] && seen[k] ? 1 : 0;
+  }
+  std::vector<int> gaps;
+  for (std::size_t k = 1; k < keyframes; ++k) {
+    if (shared[k] < min_shared) gaps.push_back(static_cast<int>(k));
+  }
+  return gaps;
+}
+
+// Odometry distance travelled up to each keyframe.
+std::vector<double> Travel(const std::vector<MappingKeyframe>& keyframes) {
+  std::vector<double> travel(keyframes.size(), 0.0);
+  for (std::size_t k = 1; k < keyframes.size(); ++k) {
+    travel[k] = travel[k - 1] + (keyframes[k].T_prior.translation() - keyframes[k - 1].T_prior.translation()).norm();
+  }
+  return travel;
+}
+
+// Loop closures: for each keyframe, earlier keyframes at least `min_travel` back that the map's
+// vocabulary retrieves near its present position (the odometry's drift bounds the radius); each
+// verified by the ring's pose against that keyframe's points, as the localizer does. The best
+// verified candidate per query becomes a loop edge.
+std::vector<LoopEdge> FindLoops(const VisualMap& provisional, const robot::CameraRig& rig,
+                                const MapBuilderOptions& options, const std::vector<MappingKeyframe>& keyframes,
+                                MapBuildStats* stats) {
+  const LoopClosureOptions& o = options.loops;
+  const std::vector<double> travel = Travel(keyframes);
+  LocalizerOptions localizer_options;
+  localizer_options.features = options.features;
+  localizer_options.retrieval = Retrieval::kCombined;
+  localizer_options.prior_radius = o.search_radius + o.search_radius_per_m * (travel.empty() ? 0.0 : travel.back());
+  localizer_options.pose.min_inliers = o.min_inliers;
+  const VisualLocalizer localizer(provisional, rig, localizer_options);
+  std::vector<LoopEdge> loops;
+  for (std::size_t q = 0; q < keyframes.size(); ++q) {
+    VisualLocalizer::FrameFeatures features;
+    std::vector<cv::Mat> descriptors;
+    for (std::size_t c = 0; c < keyframes[q].images.size(); ++c) {
+      const MappingImage& image = keyframes[q].images[c];
+      for (const auto& bearing : image.bearings) {
+        features.camera.push_back(static_cast<int>(c));
+        features.bearings.push_back(bearing);
+      }
+      if (image.descriptors.rows > 0) descriptors.push_back(image.descriptors);
+    }
+    if (descriptors.empty()) continue;
+    cv::vconcat(descriptors, features.descriptors);
+    localizer.AssignWords(&features);
+    const Eigen::Vector2d position = keyframes[q].T_map_base.translation().head<2>();
+    std::vector<int> candidates;
+    for (int c : localizer.Retrieve(features, position, Retrieval::kCombined, 8 * o.candidates)) {
+      const double since = travel[q] - travel[static_cast<std::size_t>(c)];
+      const double radius = o.search_radius + o.search_radius_per_m * since;
+      const Eigen::Vector2d there = keyframes[static_cast<std::size_t>(c)].T_map_base.translation().head<2>();
+      if (since >= o.min_travel && (there - position).norm() <= radius) candidates.push_back(c);
+      if (static_cast<int>(candidates.size()) == o.candidates) break;
+    }
+    std::optional<LoopEdge> best;
+    for (int c : candidates) {
+      ++stats->loops_tried;
+      const RigPoseResult pose =
+          EstimateRigPose(localizer.Match(features, {c}), localizer.T_base_camera(), localizer_options.pose);
+      const int inliers = static_cast<int>(pose.inliers.size());
+      if (!pose.success || inliers < o.min_inliers || (best && best->inliers >= inliers)) continue;
+      best = LoopEdge{static_cast<int>(q), c, inliers,
+                      keyframes[static_cast<std::size_t>(c)].T_map_base.inverse() * pose.T_map_base, 1.0};
+    }
+    if (best) loops.push_back(*best);
+  }
+  return loops;
+}
+
+}  // namespace
+
+double SurveyedShape::SignedDistance(const Eigen::Vector3d& point) const {
+  // Into the shape's own frame.
+  const Eigen::Vector3d d = point - centre;
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const Eigen::Vector3d p(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());
+  const Eigen::Vector3d half = size / 2;
+  switch (kind) {
+    case Kind::kBox: {
+      const Eigen::Vector3d q = p.cwiseAbs() - half;
+      return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+    }
+    case Kind::kCylinder: {
+      const double k = std::hypot(p.x() / half.x(), p.y() / half.y());
+      const double radial = k > 1e-9 ? (k - 1.0) * std::hypot(p.x(), p.y()) / k : -std::min(half.x(), half.y());
+      const Eigen::Vector2d q(radial, std::abs(p.z()) - half.z());
+      return q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+    }
+    case Kind::kEllipsoid: {
+      const double k0 = p.cwiseQuotient(half).norm();
+      const double k1 = p.cwiseQuotient(half.cwiseProduct(half)).norm();
+      return k1 > 1e-12 ? k0 * (k0 - 1.0) / k1 : -half.minCoeff();
+    }
+  }
+  return 0.0;
+}
+
+const char* ToString(KeyframePoses poses) { return poses == KeyframePoses::kOdometry ? "log" : "surveyed"; }
+
+KeyframePoses KeyframePosesFromString(const std::string& name) {
+  if (name == "log") return KeyframePoses::kOdometry;
+  if (name == "surveyed") return KeyframePoses::kSurveyed;
+  throw std::invalid_argument("unknown map builder '" + name + "' (log or surveyed)");
+}
+
+MapBuilder::MapBuilder(const robot::CameraRig& rig, const MapBuilderOptions& options) : rig_(rig), options_(options) {}
+
+bool MapBuilder::WantsFrame(const Eigen::Isometry3d& T) const {
+  if (keyframes_.empty()) return true;
+  const Eigen::Isometry3d& last = keyframes_.back().T_prior;
+  return (T.translation() - last.translation()).norm() >= options_.keyframe_distance ||
+         RotationAngle(last.linear().transpose() * T.linear()) >= options_.keyframe_angle;
+}
+
+bool MapBuilder::AddFrame(const messages::RingFrame& frame, const Eigen::Isometry3d& T_map_base) {
+  ++stats_.frames;
+  if (!WantsFrame(T_map_base)) return false;
+  const auto start = Clock::now();
+  std::vector<MappingImage> images(static_cast<std::size_t>(rig_.size()));
+  for (const auto& image : frame.images) {
+    if (image.camera_index >= 0 && image.camera_index < rig_.size()) {
+      images[static_cast<std::size_t>(image.camera_index)] =
+          ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
+    }
+  }
+  stats_.seconds_features += Since(start);
+  AddKeyframe(frame.stamp, std::move(images), T_map_base);
+  return true;
+}
+
+void MapBuilder::AddKeyframe(double stamp, std::vector<MappingImage> images, const Eigen::Isometry3d& T_map_base) {
+  images.resize(static_cast<std::size_t>(rig_.size()));
+  keyframes_.push_back({stamp, T_map_base, T_map_base, std::move(images)});
+}
+
+VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
+  const bool odometry = options_.poses == KeyframePoses::kOdometry;
+  auto start = Clock::now();
+  std::vector<ImageMatch> matches = MatchKeyframes(
+      keyframes_, rig_, odometry ? options_.odometry_epipolar_angle : options_.epipolar_angle, options_, &stats_);
+  std::vector<PointTrack> points =
+      TriangulateTracks(keyframes_, rig_, matches, options_, 4.0 * options_.epipolar_angle, &stats_);
+  stats_.seconds_matching = Since(start);
   start = Clock::now();
-  if (!map.descriptors.empty()) map.vocabulary = TrainVocabulary(map.descriptors, options_.vocabulary_words);
+  WheelScales scales = MakeWheelScales(keyframes_, options_.odometry);
+  if (!odometry) AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
+  stats_.seconds_adjustment = Since(start);
+  if (odometry) {
+    // A provisional map (one adjustment, outliers dropped) for retrieval and the loops' poses.
+    start = Clock::now();
+    std::vector<double> errors;
+    Adjust(rig_, options_, keyframes_, points, scales, &errors);
+    RemoveOutliers(errors, options_.max_reprojection_error, points);
+    stats_.seconds_adjustment += Since(start);
+    // Close the loops on it, then match again where the corrected poses allow.
+    start = Clock::now();
+    loops_ = FindLoops(MakeMap(garden, rig_, options_, keyframes_, points), rig_, options_, keyframes_, &stats_);
+    OptimizePoseGraph(options_, keyframes_, loops_);
+    std::vector<ImageMatch> kept;
+    for (const auto& m : matches) {
+      if (EpipolarAngle(keyframes_, rig_, m) <= options_.epipolar_angle) kept.push_back(m);
+    }
+    for (const auto& loop : loops_) {
+      if (loop.weight < 0.5) continue;  // the pose graph did not believe it
+      ++stats_.loops_accepted;
+      for (int k = std::max(0, loop.match - 1); k <= std::min(keyframes() - 1, loop.match + 1); ++k) {
+        MatchKeyframePair(keyframes_, rig_, k, loop.query, options_.epipolar_angle, options_, &stats_, &kept);
+      }
+    }
+    matches = std::move(kept);
+    stats_.seconds_loops = Since(start);
+    start = Clock::now();
+    points = TriangulateTracks(keyframes_, rig_, matches, options_, 4.0 * options_.epipolar_angle, &stats_);
+    AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
+    stats_.seconds_adjustment += Since(start);
+    stats_.scale_stretches = static_cast<int>(scales.scale.size());
+    stats_.scale_min = *std::min_element(scales.scale.begin(), scales.scale.end());
+    stats_.scale_max = *std::max_element(scales.scale.begin(), scales.scale.end());
+    if (!shapes_.empty()) {
+      stats_.tie_correction =
+          TieToShapes(points, shapes_, options_.tie, &stats_.tie_points, &stats_.tie_residual_median);
+      Eigen::Isometry3d T_tie = Eigen::Isometry3d::Identity();
+      T_tie.linear() = Eigen::AngleAxisd(stats_.tie_correction.z(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      T_tie.translation() << stats_.tie_correction.x(), stats_.tie_correction.y(), 0.0;
+      for (auto& k : keyframes_) k.T_map_base = T_tie * k.T_map_base;
+      for (auto& p : points) p.position = T_tie * p.position;
+    }
+  }
+  stats_.gaps = FindGaps(keyframes_.size(), points, options_.min_shared_points);
+  start = Clock::now();
+  VisualMap map = MakeMap(garden, rig_, options_, keyframes_, points);
   stats_.seconds_vocabulary = Since(start);
   stats_.keyframes = static_cast<int>(map.keyframes.size());
   stats_.points = static_cast<int>(map.points.size());

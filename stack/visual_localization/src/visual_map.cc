@@ -70,13 +70,15 @@ void WriteSchema(sqlite3* db, const VisualMap& map) {
        "CREATE TABLE observations(keyframe INTEGER, camera INTEGER, point INTEGER, u REAL, v REAL);"
        "CREATE TABLE vocabulary(word INTEGER PRIMARY KEY, centroid BLOB NOT NULL);");
   Statement meta = Prepare(db, "INSERT INTO meta VALUES(?, ?)");
-  for (const auto& [key, value] :
-       std::vector<std::pair<std::string, std::string>>{{"format", "trimbot visual map"},
-                                                        {"version", std::to_string(kMapFormatVersion)},
-                                                        {"garden", map.garden},
-                                                        {"rig_signature", map.rig_signature},
-                                                        {"descriptor", ToString(map.descriptor)},
-                                                        {"descriptor_size", std::to_string(map.descriptors.cols)}}) {
+  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+           {"format", "trimbot visual map"},
+           {"version", std::to_string(kMapFormatVersion)},
+           {"garden", map.garden},
+           {"rig_signature", map.rig_signature},
+           {"descriptor", ToString(map.descriptor)},
+           {"descriptor_size", std::to_string(map.descriptors.cols)},
+           {"builder", map.builder},
+           {"appearance_version", std::to_string(map.appearance_version)}}) {
     sqlite3_bind_text(meta.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT);
     sqlite3_bind_text(meta.get(), 2, value.c_str(), -1, SQLITE_TRANSIENT);
     Step(db, meta.get());
@@ -207,6 +209,8 @@ VisualMap VisualMap::Load(const std::string& path, const std::string& expected_g
     map.garden = Meta(db.get(), "garden");
     map.rig_signature = Meta(db.get(), "rig_signature");
     map.descriptor = DescriptorFromString(Meta(db.get(), "descriptor"));
+    map.builder = Meta(db.get(), "builder");
+    map.appearance_version = std::stoi(Meta(db.get(), "appearance_version"));
     ReadRows(db.get(), std::stoi(Meta(db.get(), "descriptor_size")), &map);
     if (map.points.empty()) throw SqlError("the map has no points");
     if (map.vocabulary.empty()) throw SqlError("the map has points but no vocabulary");

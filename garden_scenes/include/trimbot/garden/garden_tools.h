@@ -46,6 +46,14 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
 // Writes <dir>/<name>.png and <dir>/<name>.yaml in ROS map_server format.
 void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const std::string& name);
 
+// A point on a true surface of the garden, with its class and object id (kGroundObjectId: lawn).
+struct SurfaceSample {
+  Eigen::Vector3d position;
+  ObjectClass object_class;
+  int object = 0;
+};
+// Seeded samples of the garden's surfaces (as WriteGroundTruthPly writes them).
+std::vector<SurfaceSample> SampleSurfaces(const Garden& garden, double growth, double points_per_m2);
 // Samples the garden's surfaces (ground, paths, object meshes as grown under `growth`, shaped by the
 // garden's appearance seed) into an ASCII PLY point cloud with per-point class and object id.
 void WriteGroundTruthPly(const Garden& garden, double growth, double points_per_m2, const std::string& path);

@@ -15,7 +15,8 @@
 
 namespace trimbot::visual_localization {
 
-constexpr int kMapFormatVersion = 2;  // 2: the descriptor kind is recorded
+// 2: the descriptor kind is recorded; 3: the builder and the garden's appearance version.
+constexpr int kMapFormatVersion = 3;
 
 struct MapKeyframe {
   int id = 0;
@@ -34,6 +35,10 @@ struct VisualMap {
   std::string garden;                                // the garden the map was made in
   std::string rig_signature;                         // RigSignature() of the calibration it was made with
   Descriptor descriptor = Descriptor::kUprightSift;  // of the points and the vocabulary
+  std::string builder;                               // "log" or "surveyed" (KeyframePoses)
+  // The version of the garden's appearance the mapping drive's images showed (the twin's texture
+  // generator; on the real robot 0): a map of another appearance is refused where it is known.
+  int appearance_version = 0;
   std::vector<MapKeyframe> keyframes;
   std::vector<Eigen::Vector3d> points;  // map frame; id = index
   cv::Mat descriptors;                  // CV_32F, one row per point
