@@ -118,11 +118,14 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
 }
 
 Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
+  return BelievedPose(scenario.setting.start, scenario.initial_position_sigma, scenario.initial_yaw_sigma, seed);
+}
+
+Pose2 BelievedPose(const Pose2& start, double position_sigma, double yaw_sigma, std::uint64_t seed) {
   Rng rng = MakeRng(seed, "initial_pose");
   const double dx = StandardNormal(rng), dy = StandardNormal(rng), dyaw = StandardNormal(rng);
-  const Pose2& start = scenario.setting.start;
-  return {start.x + scenario.initial_position_sigma * dx, start.y + scenario.initial_position_sigma * dy,
-          std::remainder(start.yaw + scenario.initial_yaw_sigma * dyaw, 2.0 * M_PI)};
+  return {start.x + position_sigma * dx, start.y + position_sigma * dy,
+          std::remainder(start.yaw + yaw_sigma * dyaw, 2.0 * M_PI)};
 }
 
 namespace {

@@ -37,6 +37,8 @@ const garden::GardenObject& BushOf(const garden::Garden& garden, int id, const S
 
 // Where the operator believes the robot stands: the true start with seeded placement error.
 Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed);
+// The same for any start: `start` + seeded noise of these sigmas (m per axis, rad).
+Pose2 BelievedPose(const Pose2& start, double position_sigma, double yaw_sigma, std::uint64_t seed);
 
 // The camchain the stack reads: the true calibration, or with the scenario's seeded calibration
 // error written to <dir>/stack_camchain.yaml. Returns the file's path.

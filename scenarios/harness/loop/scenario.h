@@ -35,6 +35,11 @@ struct PassCriterion {
 // centre and outline are picked by eye.
 constexpr double kTapeSurveyPointSigma = 0.02;
 
+// Where the robot is put down against where it is believed to be, unless a scenario says
+// otherwise (`initial_pose_sigma`): near, not at, a marked start.
+constexpr double kInitialPositionSigma = 0.1;            // m per axis
+constexpr double kInitialYawSigma = 3.0 * M_PI / 180.0;  // rad
+
 struct Survey {
   // The survey's errors (SurveyedGarden): every object's centre is a point located with
   // `point_sigma` (m, per axis); each extent is the distance between two such points on its
@@ -99,10 +104,10 @@ struct Scenario {
   double goal_tolerance = 0.3;  // m: a goal counts as reached within this (ground truth)
   // A bush goal counts as reached when the arm's axis stands within these of the standoff
   // distance and bearing the stack aimed at (ground truth).
-  double bush_distance_tolerance = 0.03;               // m
-  double bush_bearing_tolerance = 3.0 * M_PI / 180.0;  // rad
-  double initial_position_sigma = 0.1;                 // m per axis: the stack's start belief = truth + this noise
-  double initial_yaw_sigma = 3.0 * M_PI / 180.0;       // rad
+  double bush_distance_tolerance = 0.03;                  // m
+  double bush_bearing_tolerance = 3.0 * M_PI / 180.0;     // rad
+  double initial_position_sigma = kInitialPositionSigma;  // m per axis: the stack's start belief = truth + this noise
+  double initial_yaw_sigma = kInitialYawSigma;            // rad
   CalibrationError calibration_error;
   std::string visual_map;  // map file for localization: visual (relative to this file)
   // Or the mapping drive the map is built from on first use (then cached; the batch sets

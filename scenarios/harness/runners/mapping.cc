@@ -85,12 +85,19 @@ class LogRecorder : public Observer {
  public:
   LogRecorder(visual_localization::MapBuilder& builder, stack::InertialOdometry& odometry)
       : builder_(builder), odometry_(odometry) {}
+  // Whether the builder wants the ring rendered now (asked before the step's sensors arrive).
+  bool Demand() {
+    demanded_ = builder_.WantsFrame(ToIsometry(odometry_.pose()));
+    return demanded_;
+  }
   void Observe(const StepView& step) override {
     for (const auto& imu : step.sensors.imu) odometry_.Add(imu);
     for (const auto& ticks : step.sensors.wheel_ticks) odometry_.Add(ticks);
-    if (step.sensors.ring && builder_.AddFrame(*step.sensors.ring, ToIsometry(odometry_.pose()))) {
+    // Only a ring the builder asked for is whole (a stack may ask for a few cameras of others).
+    if (step.sensors.ring && demanded_ && builder_.AddFrame(*step.sensors.ring, ToIsometry(odometry_.pose()))) {
       truth_.push_back({step.sensors.ring->stamp, step.truth.T_map_base});
     }
+    demanded_ = false;
   }
   const std::vector<StampedPose>& truth() const { return truth_; }
 
@@ -98,6 +105,7 @@ class LogRecorder : public Observer {
   visual_localization::MapBuilder& builder_;
   stack::InertialOdometry& odometry_;
   std::vector<StampedPose> truth_;  // evaluation only
+  bool demanded_ = false;
 };
 
 // Mean position error (m) of the map's keyframes against the ground truth at their stamps.
@@ -113,7 +121,7 @@ nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const S
           {"adjusted_position_error_mean_m", ErrorStats::From(adjusted).mean}};
 }
 
-constexpr double kSurfaceSamplesPerM2 = 2500.0;  // 2 cm apart: the point error is resolved to ~1 cm
+constexpr double kSurfaceSamplesPerM2 = 10000.0;  // 1 cm apart: the point error is resolved to a few mm
 
 // A log-built map against the truth: keyframes (and the odometry they started from), points
 // against the garden's true surfaces; TUM files of all three trajectories for evo.
@@ -152,9 +160,11 @@ std::vector<visual_localization::SurveyedShape> SurveyedShapes(const garden::Gar
   using Kind = visual_localization::SurveyedShape::Kind;
   std::vector<visual_localization::SurveyedShape> shapes;
   for (const auto& object : surveyed.objects) {
-    const Kind kind = object.shape == garden::Shape::kBox        ? Kind::kBox
-                      : object.shape == garden::Shape::kCylinder ? Kind::kCylinder
-                                                                 : Kind::kEllipsoid;
+    // A trunk is rendered as a cylinder whatever its surveyed shape (object_mesh.cc).
+    const Kind kind = object.object_class == garden::ObjectClass::kTrunk ? Kind::kCylinder
+                      : object.shape == garden::Shape::kBox              ? Kind::kBox
+                      : object.shape == garden::Shape::kCylinder         ? Kind::kCylinder
+                                                                         : Kind::kEllipsoid;
     const Eigen::Vector3d centre(object.position.x(), object.position.y(), object.base_height + object.size.z() / 2);
     shapes.push_back({kind, centre, object.size, object.yaw});
   }
@@ -175,8 +185,7 @@ struct MappingDrive {
   std::optional<SimulatedPoseFixes> fixes;
   visual_localization::Descriptor descriptor;  // the stack's, whose localizer will use the map
   stack::EkfParameters ekf;                    // the stack's, for the log builder's odometry
-  Pose2
-      believed_start;  // where the robot is believed to start: the plan's start as stated, a scenario's with its error
+  Pose2 believed_start;     // where the robot is believed to start (the stated start, put down with an error)
   garden::Garden surveyed;  // the garden as the user surveyed it (its errors included)
 };
 
@@ -191,7 +200,9 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
     drive->duration = std::min(drive->plan->duration(), options.recipe.seconds.value_or(drive->plan->duration()));
     drive->pilot = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
     drive->ekf = parameters.ekf;
-    drive->believed_start = drive->setting.start;
+    // The plan states where the robot starts; it is put down near, not at, that point.
+    drive->believed_start =
+        BelievedPose(drive->setting.start, kInitialPositionSigma, kInitialYawSigma, drive->setting.seed);
     Survey survey;
     survey.seed = drive->setting.seed;
     drive->surveyed = SurveyedGarden(LoadGarden(drive->setting, options.paths), survey, options.recipe.plan_path);
@@ -311,7 +322,7 @@ int RunMapBuild(const MapBuildOptions& options) {
   loop.time_limit = drive->duration;
   loop.render_on_demand = true;
   loop.ring_demand = [&](const sim::GroundTruth& truth) {
-    return from_log ? builder.WantsFrame(ToIsometry(odometry.pose())) : builder.WantsFrame(survey.PoseAt(truth));
+    return from_log ? log_recorder.Demand() : builder.WantsFrame(survey.PoseAt(truth));
   };
   loop.pose_fixes = drive->fixes ? &*drive->fixes : nullptr;
   // Progress every 10 simulated seconds: a mapping drive renders for minutes.

@@ -177,7 +177,8 @@ void AddOdometryFactors(const OdometryFactorOptions& o, const std::vector<Mappin
           &scales.scale[s - 1], &scales.scale[s]);
     }
   }
-  if (!poses.empty()) problem->SetParameterBlockConstant(poses[0].data());
+  if (!poses.empty() && problem->HasParameterBlock(poses[0].data()))
+    problem->SetParameterBlockConstant(poses[0].data());
 }
 
 ceres::Solver::Options SolverOptions(int iterations) {
@@ -199,8 +200,14 @@ WheelScales MakeWheelScales(const std::vector<MappingKeyframe>& keyframes, const
     scales.stretch_of_step[k] = static_cast<int>(std::floor(travelled / options.scale_stretch));
     travelled += step;
   }
-  const int stretches = keyframes.size() < 2 ? 1 : scales.stretch_of_step.back() + 1;
-  scales.scale.assign(static_cast<std::size_t>(stretches), 1.0);
+  // Numbered consecutively: a step longer than a stretch (frames missing) must not leave a scale no
+  // step uses, which would cut the chain of priors between its neighbours.
+  std::vector<int> compact(scales.stretch_of_step.size(), 0);
+  for (std::size_t k = 2; k < keyframes.size(); ++k) {
+    compact[k] = compact[k - 1] + (scales.stretch_of_step[k] != scales.stretch_of_step[k - 1] ? 1 : 0);
+  }
+  scales.stretch_of_step = compact;
+  scales.scale.assign(static_cast<std::size_t>(compact.empty() ? 1 : compact.back() + 1), 1.0);
   return scales;
 }
 
@@ -342,7 +349,6 @@ Eigen::Vector3d TieToShapes(const std::vector<PointTrack>& points, const std::ve
     if (distances.size() < 3) break;
     const Eigen::Vector3d step = -(H + 1e-9 * Eigen::Matrix3d::Identity()).ldlt().solve(g);
     tie += step;
-    if (step.head<2>().norm() < 1e-5 && std::abs(step.z()) < 1e-6 && f >= 1.0) break;
   }
   return tie;
 }

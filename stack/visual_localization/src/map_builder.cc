@@ -447,13 +447,24 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
     // Close the loops on it, then match again where the corrected poses allow.
     start = Clock::now();
     loops_ = FindLoops(MakeMap(garden, rig_, options_, keyframes_, points), rig_, options_, keyframes_, &stats_);
+    std::vector<Eigen::Isometry3d> provisional;
+    for (const auto& k : keyframes_) provisional.push_back(k.T_map_base);
     OptimizePoseGraph(options_, keyframes_, loops_);
+    // Loops the pose graph down-weights below 0.5 are dropped, and the graph solved without them.
+    std::vector<LoopEdge> accepted;
+    for (const auto& loop : loops_) {
+      if (loop.weight >= 0.5) accepted.push_back(loop);
+    }
+    if (accepted.size() < loops_.size()) {
+      for (std::size_t k = 0; k < keyframes_.size(); ++k) keyframes_[k].T_map_base = provisional[k];
+      OptimizePoseGraph(options_, keyframes_, accepted);
+    }
     std::vector<ImageMatch> kept;
     for (const auto& m : matches) {
       if (EpipolarAngle(keyframes_, rig_, m) <= options_.epipolar_angle) kept.push_back(m);
     }
-    for (const auto& loop : loops_) {
-      if (loop.weight < 0.5) continue;  // the pose graph did not believe it
+    std::srand(1);  // FLANN's trees for the loop keyframes: independent of how much the first pass drew
+    for (const auto& loop : accepted) {
       ++stats_.loops_accepted;
       for (int k = std::max(0, loop.match - 1); k <= std::min(keyframes() - 1, loop.match + 1); ++k) {
         MatchKeyframePair(keyframes_, rig_, k, loop.query, options_.epipolar_angle, options_, &stats_, &kept);

@@ -70,7 +70,9 @@ struct LoopClosureOptions {
   int min_inliers = 50;               // D3.4, Table 4: a retrieval with >= 50 verified matches is correct
   double position_sigma = 0.03;       // m, of a loop edge (the ring's pose at a few metres)
   double rotation_sigma = 0.5 * M_PI / 180;
-  double loss_scale = 1.0;  // Cauchy, in sigmas: a wrong loop cannot pull the graph far
+  // Cauchy scale (sigmas) of a loop edge's 6 residuals: sqrt of chi-square(6 dof, 95 %) = 12.59.
+  // A loop whose residual after the pose graph lies beyond it has a weight under 0.5 and is dropped.
+  double loss_scale = 3.548;
 };
 
 // An object of the garden as the user surveyed it (a hedge as a box, a bush as an ellipsoid, a
@@ -87,10 +89,12 @@ struct SurveyedShape {
 };
 
 struct TieOptions {
-  double min_height = 0.1;      // m: map points above the ground (the lawn is not surveyed)
-  double start_distance = 0.5;  // m: a point further than this from every shape is not used...
-  double end_distance = 0.15;   // ...shrinking to this over the iterations
-  double huber = 0.03;          // m: foliage's irregularity and the survey's 2 cm per point
+  double min_height = 0.1;  // m: map points above the ground (the lawn is not surveyed)
+  // m: a point further than this from every shape is not used (a start put down 10 cm / 3 deg
+  // off is 0.5 m off 10 m away)...
+  double start_distance = 1.0;
+  double end_distance = 0.15;  // ...shrinking to this over the iterations
+  double huber = 0.03;         // m: foliage's irregularity and the survey's 2 cm per point
   int iterations = 20;
 };
 

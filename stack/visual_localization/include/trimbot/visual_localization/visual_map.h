@@ -37,7 +37,7 @@ struct VisualMap {
   Descriptor descriptor = Descriptor::kUprightSift;  // of the points and the vocabulary
   std::string builder;                               // "log" or "surveyed" (KeyframePoses)
   // The version of the garden's appearance the mapping drive's images showed (the twin's texture
-  // generator; on the real robot 0): a map of another appearance is refused where it is known.
+  // generator; 0 where it is not known): the harness refuses a map file of another version.
   int appearance_version = 0;
   std::vector<MapKeyframe> keyframes;
   std::vector<Eigen::Vector3d> points;  // map frame; id = index
