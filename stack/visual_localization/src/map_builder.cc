@@ -387,14 +387,6 @@ double SurveyedShape::SignedDistance(const Eigen::Vector3d& point) const {
   return 0.0;
 }
 
-const char* ToString(KeyframePoses poses) { return poses == KeyframePoses::kOdometry ? "log" : "surveyed"; }
-
-KeyframePoses KeyframePosesFromString(const std::string& name) {
-  if (name == "log") return KeyframePoses::kOdometry;
-  if (name == "surveyed") return KeyframePoses::kSurveyed;
-  throw std::invalid_argument("unknown map builder '" + name + "' (log or surveyed)");
-}
-
 MapBuilder::MapBuilder(const robot::CameraRig& rig, const MapBuilderOptions& options) : rig_(rig), options_(options) {}
 
 bool MapBuilder::WantsFrame(const Eigen::Isometry3d& T) const {

@@ -28,6 +28,7 @@
 //   vocabulary  k-means words over the map's descriptors, for retrieval
 #include <Eigen/Geometry>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -39,9 +40,15 @@
 namespace trimbot::visual_localization {
 
 enum class KeyframePoses { kOdometry, kSurveyed };
-const char* ToString(KeyframePoses poses);  // "log" (odometry) or "surveyed": the map's builder
+// "log" (odometry) or "surveyed": the map's builder. Inline: the scenario reader (fuzzed without
+// this library) parses it too.
+inline const char* ToString(KeyframePoses poses) { return poses == KeyframePoses::kOdometry ? "log" : "surveyed"; }
 // "log" or "surveyed"; std::invalid_argument otherwise.
-KeyframePoses KeyframePosesFromString(const std::string& name);
+inline KeyframePoses KeyframePosesFromString(const std::string& name) {
+  if (name == "log") return KeyframePoses::kOdometry;
+  if (name == "surveyed") return KeyframePoses::kSurveyed;
+  throw std::invalid_argument("unknown map builder '" + name + "' (log or surveyed)");
+}
 
 // How far the wheel-inertial odometry between two keyframes is trusted (1 sigma), in the frame of
 // the first. Sources: the simulator's and D3.4's slip figures are percent-level along track (the
