@@ -1,34 +1,15 @@
 #include "evaluation/map_evaluation.h"
 
 #include <Eigen/Geometry>
-#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <stdexcept>
 
 #include "evaluation/pose_errors.h"
 #include "evaluation/trial_result.h"
+#include "trimbot/common/points_kd_tree.h"
 
 namespace trimbot::scenarios {
-namespace {
-
-nlohmann::json ToJson(const ErrorStats& s) {
-  return {{"count", s.count}, {"mean", s.mean}, {"median", s.median}, {"rmse", s.rmse}, {"max", s.max}};
-}
-
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector3d>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][static_cast<int>(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor,
-                                                   3, std::uint32_t>;
-
-}  // namespace
 
 nlohmann::json TrajectoryErrors(const std::vector<StampedPose>& estimate, const std::vector<StampedPose>& truth) {
   if (estimate.size() != truth.size()) throw std::logic_error("TrajectoryErrors: trajectories of different lengths");
@@ -49,18 +30,18 @@ nlohmann::json TrajectoryErrors(const std::vector<StampedPose>& estimate, const 
   if (n >= 3) alignment.matrix() = Eigen::umeyama(from, to, false);
   for (std::size_t i = 0; i < n; ++i) aligned.push_back(TranslationError(alignment * estimate[i].T, truth[i].T));
   const Eigen::AngleAxisd rotation(alignment.linear());
-  return {{"ate_unaligned_m", ToJson(ErrorStats::From(unaligned))},
-          {"ate_se3_aligned_m", ToJson(ErrorStats::From(aligned))},
+  return {{"ate_unaligned_m", nlohmann::json(ErrorStats::From(unaligned))},
+          {"ate_se3_aligned_m", nlohmann::json(ErrorStats::From(aligned))},
           {"alignment",
            {{"translation_m", alignment.translation().norm()}, {"rotation_deg", rotation.angle() * 180 / M_PI}}},
-          {"rpe_per_keyframe_m", ToJson(ErrorStats::From(rpe_translation))},
-          {"rpe_per_keyframe_deg", ToJson(ErrorStats::From(rpe_rotation))}};
+          {"rpe_per_keyframe_m", nlohmann::json(ErrorStats::From(rpe_translation))},
+          {"rpe_per_keyframe_deg", nlohmann::json(ErrorStats::From(rpe_rotation))}};
 }
 
 nlohmann::json PointErrors(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& surface) {
   if (points.empty() || surface.empty()) return {{"count", 0}};
   const PointsAdaptor adaptor{surface};
-  KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  PointsKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   tree.buildIndex();
   std::vector<double> distances;
   int within = 0;

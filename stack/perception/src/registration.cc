@@ -1,4 +1,5 @@
 #include "trimbot/perception/registration.h"
+#include "trimbot/common/points_kd_tree.h"
 #include "trimbot/common/rotation.h"
 
 #include "open3d_icp.h"
@@ -6,7 +7,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
-#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -24,19 +24,6 @@ namespace {
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
-// nanoflann adaptor over a vector of points.
-struct PointsAdaptor {
-  const std::vector<Eigen::Vector3d>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][static_cast<int>(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor,
-                                                   3, std::uint32_t>;
-
 // The target at one resolution: while the annealing spread is wide, the E-step meets a coarser
 // version of the target, so its k nearest points still cover a few spreads (a fixed k on the full
 // cloud would see only a few centimetres around each point and lose the wide basin).
@@ -44,11 +31,11 @@ struct TargetLevel {
   double voxel = 0.0;  // m, 0 for the full cloud
   PointCloud cloud;
   std::unique_ptr<PointsAdaptor> adaptor;
-  std::unique_ptr<KdTree> tree;
+  std::unique_ptr<PointsKdTree> tree;
 
   void Build() {
     adaptor = std::make_unique<PointsAdaptor>(PointsAdaptor{cloud.points});
-    tree = std::make_unique<KdTree>(3, *adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree = std::make_unique<PointsKdTree>(3, *adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree->buildIndex();
   }
 };
@@ -135,7 +122,7 @@ Eigen::Isometry3d WeightedKabsch(const std::vector<SourceTerms>& terms, const st
 namespace {
 
 // Median distance from a point to its nearest other point (of up to 2000 points spread over the cloud).
-double MedianSpacing(const PointCloud& cloud, const KdTree& tree) {
+double MedianSpacing(const PointCloud& cloud, const PointsKdTree& tree) {
   std::vector<double> spacing;
   for (std::size_t i = 0; i < cloud.size(); i += std::max<std::size_t>(1, cloud.size() / 2000)) {
     std::uint32_t index[2];
@@ -161,7 +148,7 @@ struct LocalSurface {
   std::vector<double> normal_variances;
 };
 
-LocalSurface SurfaceOf(const PointCloud& cloud, const KdTree& tree) {
+LocalSurface SurfaceOf(const PointCloud& cloud, const PointsKdTree& tree) {
   LocalSurface surface;
   surface.normals.assign(cloud.size(), Eigen::Vector3d::Zero());
   surface.normal_variances.assign(cloud.size(), 0.0);
@@ -226,7 +213,7 @@ void Prepare(const PointCloud& target_in, const PointCloud& source_in, const Reg
   p->levels.resize(1);
   p->levels[0].cloud = target;
   p->levels[0].Build();
-  const KdTree& tree = *p->levels[0].tree;
+  const PointsKdTree& tree = *p->levels[0].tree;
 
   // Median spacing of the target (nearest other point), the scale of "close".
   p->point_spacing = MedianSpacing(target, tree);

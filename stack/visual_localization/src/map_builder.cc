@@ -427,15 +427,15 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
   stats_.seconds_matching = Since(start);
   start = Clock::now();
   WheelScales scales = MakeWheelScales(keyframes_, options_.odometry);
-  if (!odometry) AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
-  stats_.seconds_adjustment = Since(start);
-  if (odometry) {
+  if (!odometry) {
+    AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
+    stats_.seconds_adjustment = Since(start);
+  } else {
     // A provisional map (one adjustment, outliers dropped) for retrieval and the loops' poses.
-    start = Clock::now();
     std::vector<double> errors;
     Adjust(rig_, options_, keyframes_, points, scales, &errors);
     RemoveOutliers(errors, options_.max_reprojection_error, points);
-    stats_.seconds_adjustment += Since(start);
+    stats_.seconds_adjustment = Since(start);
     // Close the loops on it, then match again where the corrected poses allow.
     start = Clock::now();
     loops_ = FindLoops(MakeMap(garden, rig_, options_, keyframes_, points), rig_, options_, keyframes_, &stats_);
