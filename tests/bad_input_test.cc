@@ -48,12 +48,15 @@ goals:
   - {approach_bush: 1}
 goal_tolerance: 0.3
 bush_tolerance: {distance: 0.1, bearing_deg: 5.0}
-conditions: {time_of_day: 11.0, day_of_year: 250, shadows: true, growth: 0.5}
+conditions: {time_of_day: 11.0, day_of_year: 250, shadows: true, growth: 0.5,
+             wind: {mean_speed: 3.5, roughness_length: 0.1},
+             clouds: {cover: 0.6, mean_shadow_duration: 60.0, direct_transmittance: 0.05, edge_duration: 5.0}}
 map: {resolution: 0.05, clearance_height: 1.0}
 survey: {growth: 0.2, unmapped: [9]}
 initial_pose_sigma: {position: 0.02, yaw_deg: 0.5}
-calibration_error: {focal_relative: 0.01, principal_point_px: 1.0, rotation_deg: 0.1, translation_m: 0.001}
-cameras: {render: false, resolution_scale: 0.5}
+calibration_error: {focal_relative: 0.01, principal_point_px: 1.0, rotation_deg: 0.1, translation_m: 0.001,
+                    camera_imu_time_offset_s: 0.001}
+cameras: {render: false, resolution_scale: 0.5, motion_blur: true}
 noise: {imu: 1.0, wheel_slip: 1.0}
 simulated_pose_fixes: {availability: 0.9, position_sigma: 0.1, yaw_sigma_deg: 2.0, latency_median: 0.2,
                        latency_log_sigma: 0.3, latency_max: 1.0, outlier_probability: 0.05, outlier_min: 0.5,

@@ -340,7 +340,9 @@ namespace {
 
 // Real features for localization: SIFT finds a few hundred keypoints in a ring image of each kind
 // of ground (measured on the rendered, distorted, noisy image), whatever the garden's seed: the
-// minimum over three appearance seeds is asserted.
+// minimum over three appearance seeds is asserted. In sunlight: under a cloud the relief shading
+// of the ground fades and SIFT finds fewer (123-209 on three of the four grounds when this run's
+// first frame fell in a cloud's shadow).
 TEST(GroundAppearance, SiftFindsFeaturesOnEveryGroundType) {
   for (const char* surface : {"grass", "gravel", "pavement", "soil"}) {
     std::size_t fewest = SIZE_MAX;
@@ -350,6 +352,7 @@ TEST(GroundAppearance, SiftFindsFeaturesOnEveryGroundType) {
                                                         std::string("name: ground_") + surface + "\n" + seed_line +
                                                             "size: [30, 30]\nground: " + surface + "\nobjects: []\n");
       SimulatorConfig config = TestConfig(garden, std::string("sift_") + surface, true);
+      config.conditions.clouds.cover = 0.0;
       Simulator simulator(config);
       const RingCapture capture = simulator.CaptureRing(false);
       const auto& image = capture.frame.images[0];

@@ -12,11 +12,13 @@
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
 #include "loop/pilots.h"
+#include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "runners/localization_eval.h"
 #include "runners/map_cache.h"
 #include "runners/mapping.h"
 #include "test_support.h"
+#include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/garden/textures.h"
 #include "trimbot/robot/camera_rig.h"
@@ -188,7 +190,9 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
   EXPECT_LT(errors["adjusted_position_error_mean_m"].get<double>(),
             errors["survey_position_error_mean_m"].get<double>())
       << "bundle adjustment brings the keyframes closer to the truth than the survey";
-  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
+  // The robot's calibration, which the map was built with.
+  const robot::CameraRig rig = scenarios::CalibratedRig(
+      robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot"))), scenarios::CalibrationError{});
   const VisualMap map = VisualMap::Load(options.out_dir + "/map.sqlite", "test_lawn", RigSignature(rig));
   EXPECT_EQ(static_cast<int>(map.points.size()), stats["points"].get<int>());
   EXPECT_GT(map.vocabulary.rows, 10);
@@ -201,7 +205,9 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
 TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const std::string dir = testing::TempDir("map_for_queries");
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
-  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
+  // The robot's calibration, which the map was built with.
+  const robot::CameraRig rig = scenarios::CalibratedRig(
+      robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot"))), scenarios::CalibrationError{});
   const scenarios::DrivePlan plan =
       scenarios::DrivePlan::Load(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
   scenarios::Setting setting = plan.setting;
@@ -247,7 +253,9 @@ TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   }
   // The stack on this map asks the ring for what its localizer uses: the left camera of each pair
   // at stack.yaml's image_scale, when a localization is due, and nothing while it is busy.
-  const robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
+  robot::RobotFiles files = robot::RobotFiles::InFolder(testing::SourcePath("robot"));
+  files.camchain = dir + "/robot_camchain.yaml";  // the robot's calibration, the map's
+  WriteFileAtomically(files.camchain, robot::CameraRig::FromCameras(rig.cameras(), files.camchain).ToKalibrYaml());
   const stack::StackParameters parameters = stack::StackParameters::Load(files.stack_parameters);
   ASSERT_EQ(parameters.localization, stack::LocalizationSource::kVisual);
   stack::RobotStack robot(files, parameters, 1);

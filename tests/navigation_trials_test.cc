@@ -157,10 +157,18 @@ TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {
   EXPECT_GT(error, 0.0);
   EXPECT_LT(error, 5 * s.initial_position_sigma);
 
-  EXPECT_EQ(StackCalibration(s, paths, 1, testing::TempDir("calibration")), paths.robot_files().camchain);
+  // The robot's calibration is on by default (Kalibr's residuals); zeros give the true camchain.
+  EXPECT_TRUE(s.calibration_error.any());
+  EXPECT_EQ(s.visual_map_recipe ? s.visual_map_recipe->calibration_error.seed : s.calibration_error.seed,
+            s.calibration_error.seed);
+  Scenario exact = s;
+  exact.calibration_error = CalibrationError{0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(StackCalibration(exact, paths, testing::TempDir("calibration")), paths.robot_files().camchain);
+  EXPECT_EQ(CameraImuTimeOffset(exact.calibration_error), 0.0);
+  EXPECT_NE(CameraImuTimeOffset(s.calibration_error), 0.0);
   s.calibration_error.focal_relative = 0.01;
   s.calibration_error.rotation_deg = 0.5;
-  const std::string perturbed = StackCalibration(s, paths, 1, testing::TempDir("calibration"));
+  const std::string perturbed = StackCalibration(s, paths, testing::TempDir("calibration"));
   const robot::RobotDescription description = robot::RobotDescription::Load(paths.robot_files().urdf);
   const Eigen::Isometry3d T_base_cam0 = description.FramePose(robot::RobotFrames::CameraOptical(0));
   const robot::CameraRig truth = robot::CameraRig::LoadKalibr(paths.robot_files().camchain, T_base_cam0);

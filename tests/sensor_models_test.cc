@@ -152,7 +152,9 @@ TEST(AutoExposure, BringsTheGroundToTheTargetByExposureThenGain) {
   robot::AutoExposure ae;
   ae.target_mean = 100.0;
   ae.metering_top = 0.5;
-  ae.max_exposure_factor = 2.0;
+  ae.daylight_exposure_time = 1e-3;
+  ae.min_exposure_time = 0.5e-3;
+  ae.max_exposure_time = 2e-3;
   ae.max_gain = 4.0;
   const ReadNoise noiseless(1, 16);
   cv::Mat image(100, 50, CV_8UC3, cv::Scalar(200, 200, 200));  // sky

@@ -14,6 +14,22 @@ Conditions Conditions::FromYaml(const YamlMap& map) {
   c.shadows = map.Bool("shadows", c.shadows);
   c.growth = map.Double("growth", c.growth);
   if (c.growth < 0.0 || c.growth > 1.0) map.Fail("growth", "must be in 0..1");
+  if (map.Has("wind")) {
+    const YamlMap wind = map.Map("wind");
+    Wind& w = c.wind;
+    w.mean_speed = wind.NumberOr("mean_speed", w.mean_speed, 0.0, 40.0, "m/s");
+    w.roughness_length = wind.NumberOr("roughness_length", w.roughness_length, 1e-4, 2.0, "m");
+    wind.RejectUnknownKeys();
+  }
+  if (map.Has("clouds")) {
+    const YamlMap clouds = map.Map("clouds");
+    Clouds& k = c.clouds;
+    k.cover = clouds.NumberOr("cover", k.cover, 0.0, 1.0);
+    k.mean_shadow_duration = clouds.NumberOr("mean_shadow_duration", k.mean_shadow_duration, 1.0, 36000.0, "s");
+    k.direct_transmittance = clouds.NumberOr("direct_transmittance", k.direct_transmittance, 0.0, 1.0);
+    k.edge_duration = clouds.NumberOr("edge_duration", k.edge_duration, 0.0, 600.0, "s");
+    clouds.RejectUnknownKeys();
+  }
   map.RejectUnknownKeys();
   return c;
 }

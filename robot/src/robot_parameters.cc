@@ -44,7 +44,9 @@ RobotParameters RobotParameters::Load(const std::string& path) {
   ae.enabled = exposure.Bool("enabled");
   ae.target_mean = exposure.Number("target_mean", 1.0, 254.0, "grey levels");
   ae.metering_top = exposure.Number("metering_top", 0.0, 0.95);
-  ae.max_exposure_factor = exposure.Number("max_exposure_factor", 1.0, 1000.0);
+  ae.daylight_exposure_time = exposure.Number("daylight_exposure_time", 1e-6, 1.0, "s");
+  ae.min_exposure_time = exposure.Number("min_exposure_time", 1e-7, ae.daylight_exposure_time, "s");
+  ae.max_exposure_time = exposure.Number("max_exposure_time", ae.daylight_exposure_time, 10.0, "s");
   ae.max_gain = exposure.Number("max_gain", 1.0, 1000.0);
   exposure.RejectUnknownKeys();
   cameras.RejectUnknownKeys();

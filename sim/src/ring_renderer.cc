@@ -66,7 +66,7 @@ std::array<Plane, 6> ViewVolume(const mjvGLCamera& camera, double aspect) {
 // view volume. What is dropped would be clipped by OpenGL anyway, so the image is the same; the
 // three passes of a shadowed scene (lit, shadow map, shadowed) then draw about half the garden.
 // Returns how many were dropped.
-int KeepVisibleGeoms(mjvScene* scene, double aspect) {
+int KeepVisibleGeoms(mjvScene* scene, double aspect, const std::vector<double>& margins) {
   // MuJoCo keeps two eyes ipd apart; a mono render draws from their average.
   const mjvGLCamera camera = mjv_averageCamera(&scene->camera[0], &scene->camera[1]);
   const std::array<Plane, 6> volume = ViewVolume(camera, aspect);
@@ -89,8 +89,10 @@ int KeepVisibleGeoms(mjvScene* scene, double aspect) {
   int kept = 0;
   for (int i = 0; i < scene->ngeom; ++i) {
     const mjvGeom& geom = scene->geoms[i];
-    const double radius = geom.modelrbound;
-    bool visible = radius <= 0.0;  // decor and unbounded geoms are always drawn
+    bool visible = geom.modelrbound <= 0.0;  // decor and unbounded geoms are always drawn
+    const bool has_margin =
+        geom.objtype == mjOBJ_GEOM && geom.objid >= 0 && geom.objid < static_cast<int>(margins.size());
+    const double radius = geom.modelrbound + (has_margin ? margins[static_cast<std::size_t>(geom.objid)] : 0.0);
     const Vec3 centre = ToVec(geom.pos);
     if (!visible) visible = !capsule_outside(centre, centre, radius);
     for (size_t l = 0; !visible && l < shadow_directions.size(); ++l) {
@@ -134,6 +136,43 @@ RingRenderer::RingRenderer(const World& world, const robot::CameraRig& rig, bool
   gl_->option.geomgroup[3] = 0;  // collision geometry is not drawn
   gl_->rgb.resize(static_cast<size_t>(width) * height * 3);
   gl_->depth.resize(static_cast<size_t>(width) * height);
+  sun_light_ = mj_name2id(m, mjOBJ_LIGHT, "sun");
+  if (sun_light_ >= 0) {
+    for (int i = 0; i < 3; ++i) {
+      sun_diffuse_[i] = m->light_diffuse[3 * sun_light_ + i];
+      sun_specular_[i] = m->light_specular[3 * sun_light_ + i];
+    }
+  }
+}
+
+void RingRenderer::SetSunTransmittance(double transmittance) {
+  if (sun_light_ < 0) return;
+  // The model's light is read by mjv_updateScene for each draw; physics does not use it.
+  mjModel* m = world_.model();
+  for (int i = 0; i < 3; ++i) {
+    m->light_diffuse[3 * sun_light_ + i] = static_cast<float>(sun_diffuse_[i] * transmittance);
+    m->light_specular[3 * sun_light_ + i] = static_cast<float>(sun_specular_[i] * transmittance);
+  }
+}
+
+void RingRenderer::ReplaceMeshVertices(int mesh_id, const std::vector<float>& vertices) {
+  mjModel* m = world_.model();
+  if (mesh_id < 0 || mesh_id >= m->nmesh || static_cast<int>(vertices.size()) != 3 * m->mesh_vertnum[mesh_id]) {
+    throw std::invalid_argument("RingRenderer::ReplaceMeshVertices: not the mesh's vertex count");
+  }
+  const mjModel* mc = m;
+  if (OSMesaGetCurrentContext() != gl_->context &&
+      !OSMesaMakeCurrent(gl_->context, gl_->buffer.data(), GL_UNSIGNED_BYTE, mc->vis.global.offwidth,
+                         mc->vis.global.offheight)) {
+    throw std::runtime_error("OSMesa: cannot make the context current");
+  }
+  // mjr_uploadMesh reads the model's vertices: swap the drawn ones in for the upload, then back,
+  // so collisions keep the mesh as built.
+  float* stored = m->mesh_vert + 3 * m->mesh_vertadr[mesh_id];
+  std::vector<float> kept(stored, stored + vertices.size());
+  std::copy(vertices.begin(), vertices.end(), stored);
+  mjr_uploadMesh(m, &gl_->render_context, mesh_id);
+  std::copy(kept.begin(), kept.end(), stored);
 }
 
 RingRenderer::~RingRenderer() {
@@ -189,7 +228,8 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
   view.fixedcamid = camera_id;
   mjv_updateScene(m, world_.data(), &gl_->option, nullptr, &view, mjCAT_ALL, &gl_->scene);
   const int culled =
-      frustum_culling_ ? KeepVisibleGeoms(&gl_->scene, static_cast<double>(camera.render.width) / camera.render.height)
+      frustum_culling_ ? KeepVisibleGeoms(&gl_->scene, static_cast<double>(camera.render.width) / camera.render.height,
+                                          culling_margins_)
                        : 0;
   if (!segmentation) {
     timings_.geoms_in_view += gl_->scene.ngeom;
@@ -221,11 +261,11 @@ void RingRenderer::RenderPass(const CameraSetup& camera, int camera_id, bool seg
         out[c] = in[c] >= 1.0f ? 0.0f : static_cast<float>(znear / (1.0 - in[c] * (1.0 - znear / zfar)));
       }
     }
-    timings_.ground_truth += SecondsSince(depth_start);
+    timings_.depth += SecondsSince(depth_start);
   }
 }
 
-RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_ground_truth) {
+RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_ground_truth, bool with_depth) {
   const CameraSetup& camera = Setup(index, resolution_scale);
   // Several renderers (simulators) may live in one process; each draws with its own context.
   const mjModel* m = world_.model();
@@ -237,16 +277,20 @@ RenderedView RingRenderer::Render(int index, double resolution_scale, bool with_
   const int camera_id = world_.camera_id(index);
   RenderedView view;
   cv::Mat rgb, depth;
-  RenderPass(camera, camera_id, false, &rgb, with_ground_truth ? &depth : nullptr);
+  RenderPass(camera, camera_id, false, &rgb, with_ground_truth || with_depth ? &depth : nullptr);
   auto start = Clock::now();
   cv::remap(rgb, view.rgb, camera.map_x, camera.map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   timings_.distortion += SecondsSince(start);
   ++timings_.images;
+  if (!depth.empty()) {
+    start = Clock::now();
+    cv::remap(depth, view.depth, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+    timings_.depth += SecondsSince(start);
+  }
   if (!with_ground_truth) return view;
 
   start = Clock::now();
 
-  cv::remap(depth, view.depth, camera.map_x, camera.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
   cv::Mat segmentation;
   RenderPass(camera, camera_id, true, &segmentation, nullptr);
   // Segment colour = the geom's segmentation id + 1 (its index in the scene before culling); map it

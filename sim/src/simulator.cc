@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -13,7 +14,9 @@
 #include "trimbot/sim/camera_exposure.h"
 #include "trimbot/sim/camera_noise.h"
 #include "trimbot/sim/imu_model.h"
+#include "trimbot/sim/motion_blur.h"
 #include "trimbot/sim/ring_renderer.h"
+#include "trimbot/sim/weather.h"
 #include "trimbot/sim/wheel_encoder_model.h"
 #include "trimbot/sim/world.h"
 
@@ -52,11 +55,36 @@ Eigen::Isometry3d PoseFromMujoco(const mjtNum* pos, const mjtNum* mat) {
   return pose;
 }
 
+// The velocity of a camera (optical frame) fixed on the base at T_base_camera.
+CameraTwist CameraTwistOf(const GroundTruth& truth, const Eigen::Isometry3d& T_base_camera) {
+  const Eigen::Matrix3d R_camera_base = T_base_camera.linear().transpose();
+  CameraTwist twist;
+  twist.linear =
+      R_camera_base * (truth.linear_velocity_base + truth.angular_velocity_base.cross(T_base_camera.translation()));
+  twist.angular = R_camera_base * truth.angular_velocity_base;
+  return twist;
+}
+
 }  // namespace
+
+// A plant's mesh as built, and how it moves in the wind.
+struct AnimatedPlant {
+  int mesh = -1;
+  PlantMotion motion;
+  Eigen::Matrix3d R_world_mesh;
+  std::vector<Eigen::Vector3d> rest_in_world;
+  std::vector<float> rest;      // mjModel::mesh_vert as built
+  std::vector<float> vertices;  // as drawn now
+};
 
 struct Simulator::Impl {
   std::unique_ptr<World> world;
   std::unique_ptr<RingRenderer> renderer;
+  std::unique_ptr<GustyWind> wind;
+  std::vector<AnimatedPlant> plants;
+  std::unique_ptr<CloudShadows> clouds;
+  MotionBlur motion_blur;
+  double weather_time = -1.0;  // the time the plants and the sun were last set for
   std::unique_ptr<ReadNoise> read_noise;
   std::unique_ptr<BaseController> base;
   std::unique_ptr<ArmController> arm;
@@ -130,7 +158,60 @@ Simulator::Simulator(const SimulatorConfig& config)
   if (config.render_cameras) {
     impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config.frustum_culling);
     impl_->read_noise = std::make_unique<ReadNoise>(StreamSeed(config.seed, "camera_read_noise"));
+    SetUpWeather();
   }
+}
+
+void Simulator::SetUpWeather() {
+  impl_->clouds = std::make_unique<CloudShadows>(config_.conditions.clouds, StreamSeed(config_.seed, "clouds"));
+  impl_->wind = std::make_unique<GustyWind>(config_.conditions.wind, StreamSeed(config_.seed, "wind"));
+  if (config_.conditions.wind.mean_speed <= 0.0) return;
+  const World& world = *impl_->world;
+  const mjModel* m = world.model();
+  const mjData* d = world.data();
+  std::vector<double> margins(static_cast<std::size_t>(m->ngeom), 0.0);
+  for (int g = 0; g < m->ngeom; ++g) {
+    const GeomLabel* label = world.label(g);
+    if (label == nullptr || label->is_ground || m->geom_type[g] != mjGEOM_MESH) continue;
+    const auto found = std::find_if(garden_.objects.begin(), garden_.objects.end(),
+                                    [&](const garden::GardenObject& o) { return o.id == label->object_id; });
+    const garden::GardenObject* object = found == garden_.objects.end() ? nullptr : &*found;
+    if (object == nullptr || MechanicsOf(object->object_class).sway_frequency <= 0.0) continue;
+    const Eigen::Vector3d base(object->position.x(), object->position.y(), object->base_height);
+    AnimatedPlant plant{m->geom_dataid[g],
+                        PlantMotion(*impl_->wind, object->object_class, object->id, base, object->size.z()),
+                        Eigen::Matrix3d::Identity(),
+                        {},
+                        {},
+                        {}};
+    const Eigen::Isometry3d pose = PoseFromMujoco(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g);
+    plant.R_world_mesh = pose.linear();
+    const float* vertex = m->mesh_vert + 3 * m->mesh_vertadr[plant.mesh];
+    plant.rest.assign(vertex, vertex + 3 * m->mesh_vertnum[plant.mesh]);
+    for (int v = 0; v < m->mesh_vertnum[plant.mesh]; ++v) {
+      plant.rest_in_world.push_back(pose * Eigen::Vector3d(vertex[3 * v], vertex[3 * v + 1], vertex[3 * v + 2]));
+    }
+    plant.vertices = plant.rest;
+    margins[static_cast<std::size_t>(g)] = plant.motion.MaxDisplacement();
+    impl_->plants.push_back(std::move(plant));
+  }
+  impl_->renderer->SetCullingMargins(std::move(margins));
+}
+
+void Simulator::SetWeatherFor(double t) {
+  if (t == impl_->weather_time) return;
+  impl_->weather_time = t;
+  impl_->renderer->SetSunTransmittance(impl_->clouds->DirectTransmittance(t));
+  const auto start = std::chrono::steady_clock::now();
+  for (AnimatedPlant& plant : impl_->plants) {
+    const Eigen::Matrix3d R_mesh_world = plant.R_world_mesh.transpose();
+    for (std::size_t v = 0; v < plant.rest_in_world.size(); ++v) {
+      const Eigen::Vector3d moved = R_mesh_world * plant.motion.Displacement(plant.rest_in_world[v], t);
+      for (int k = 0; k < 3; ++k) plant.vertices[3 * v + k] = plant.rest[3 * v + k] + static_cast<float>(moved[k]);
+    }
+    impl_->renderer->ReplaceMeshVertices(plant.mesh, plant.vertices);
+  }
+  impl_->timings.wind += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 Simulator::~Simulator() = default;
@@ -278,6 +359,7 @@ SimulatorTimings Simulator::timings() const {
     out.render_draw = r.draw;
     out.render_readback = r.readback;
     out.distortion = r.distortion;
+    out.depth = r.depth;
     out.ground_truth = r.ground_truth;
     out.camera_images = r.images;
     out.geoms_drawn = r.geoms_in_view;
@@ -305,22 +387,38 @@ RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool wi
   }
   World& world = *impl_->world;
   mj_forward(world.model(), world.data());  // kinematics at the current time
+  const double exposed_at = world.data()->time;
+  SetWeatherFor(exposed_at);
+  const GroundTruth now = ground_truth();
   RingCapture capture;
-  capture.frame.stamp = world.data()->time;
+  // The camera's clock is off the IMU's by the calibration's residual offset.
+  capture.frame.stamp = exposed_at + config_.camera_time_offset;
   RingTruth& truth = capture.truth;
   if (with_ground_truth) truth.views.resize(static_cast<std::size_t>(rig_.size()));
+  const bool moving = now.linear_velocity_base.norm() > 1e-4 || now.angular_velocity_base.norm() > 1e-4;
   for (int i : request.cameras) {
-    RenderedView view = impl_->renderer->Render(i, request.resolution_scale, with_ground_truth);
-    const auto start = std::chrono::steady_clock::now();
+    const bool blur = config_.motion_blur && moving;
+    RenderedView view = impl_->renderer->Render(i, request.resolution_scale, with_ground_truth, blur);
+    auto start = std::chrono::steady_clock::now();
     // The sensor's exposure control, then the read-out: signal times exposure and gain, plus read
     // noise (amplified by the gain) seeded per frame and camera so each image is reproducible alone.
     const ExposureResult exposure = MeterExposure(view.rgb, parameters_.cameras.auto_exposure);
+    impl_->timings.exposure_noise += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (blur) {
+      start = std::chrono::steady_clock::now();
+      const double exposure_time = parameters_.cameras.auto_exposure.daylight_exposure_time * exposure.exposure_factor;
+      impl_->motion_blur.Apply(i * 100000 + view.rgb.cols, impl_->renderer->Model(i, request.resolution_scale),
+                               view.depth, CameraTwistOf(now, rig_.camera(i).T_base_camera), exposure_time, &view.rgb);
+      if (!with_ground_truth) view.depth.release();
+      impl_->timings.motion_blur += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    start = std::chrono::steady_clock::now();
     const std::uint64_t image_seed =
         StreamSeed(config_.seed, "camera/" + std::to_string(impl_->frame) + "/" + std::to_string(i));
     impl_->read_noise->ReadOut(view.rgb, exposure.exposure_factor * exposure.gain,
                                parameters_.cameras.noise_sigma * exposure.gain, image_seed);
     messages::Image image;
-    image.stamp = capture.frame.stamp;
+    image.stamp = capture.frame.stamp;  // the camera's clock
     image.camera_index = i;
     image.width = view.rgb.cols;
     image.height = view.rgb.rows;

@@ -141,13 +141,8 @@ Eigen::Isometry3d SmallMotion(Rng& rng, double rotation_sigma, double translatio
 
 }  // namespace
 
-std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, std::uint64_t seed,
-                             const std::string& dir) {
-  const robot::RobotFiles files = paths.robot_files();
-  const CalibrationError& error = scenario.calibration_error;
-  if (!error.any()) return files.camchain;
-  const robot::CameraRig truth = robot::LoadCameraRig(files);
-  Rng rng = MakeRng(seed, "calibration_error");
+robot::CameraRig CalibratedRig(const robot::CameraRig& truth, const CalibrationError& error) {
+  Rng rng = MakeRng(error.seed, "calibration_error");
   std::vector<robot::CameraCalibration> cameras = truth.cameras();
   for (auto& camera : cameras) {
     auto& k = camera.intrinsics;
@@ -160,8 +155,21 @@ std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths
     // cam0's pose on the robot comes from the URDF; the chain to the others is the camchain's.
     if (camera.index > 0) camera.T_base_camera = camera.T_base_camera * motion;
   }
+  return robot::CameraRig::FromCameras(cameras, truth.source());
+}
+
+double CameraImuTimeOffset(const CalibrationError& error) {
+  Rng rng = MakeRng(error.seed, "camera_imu_time_offset");
+  return error.camera_imu_time_offset_s * StandardNormal(rng);
+}
+
+std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, const std::string& dir) {
+  const robot::RobotFiles files = paths.robot_files();
+  const CalibrationError& error = scenario.calibration_error;
+  if (!error.any()) return files.camchain;
   const std::string path = dir + "/stack_camchain.yaml";
-  WriteFileAtomically(path, robot::CameraRig::FromCameras(cameras, path).ToKalibrYaml());
+  const robot::CameraRig rig = CalibratedRig(robot::LoadCameraRig(files), error);
+  WriteFileAtomically(path, robot::CameraRig::FromCameras(rig.cameras(), path).ToKalibrYaml());
   return path;
 }
 

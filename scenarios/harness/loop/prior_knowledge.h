@@ -42,8 +42,15 @@ Pose2 BelievedPose(const Pose2& start, double position_sigma, double yaw_sigma, 
 
 // The camchain the stack reads: the true calibration, or with the scenario's seeded calibration
 // error written to <dir>/stack_camchain.yaml. Returns the file's path.
-std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, std::uint64_t seed,
-                             const std::string& dir);
+// The calibration the robot's stack reads: the true rig with the calibration's seeded errors.
+robot::CameraRig CalibratedRig(const robot::CameraRig& truth, const CalibrationError& error);
+// The cameras' clock against the IMU's (s, SimulatorConfig::camera_time_offset): the calibration's
+// residual, seeded alike; the stack assumes 0.
+double CameraImuTimeOffset(const CalibrationError& error);
+
+// The camchain the stack reads: the true calibration, or with the scenario's calibration error
+// written to <dir>/stack_camchain.yaml. Returns the file's path.
+std::string StackCalibration(const Scenario& scenario, const ProjectPaths& paths, const std::string& dir);
 
 // The stack's parameters for this scenario. Throws InputError naming the file and key.
 stack::StackParameters StackParametersFor(const Scenario& scenario, const ProjectPaths& paths);

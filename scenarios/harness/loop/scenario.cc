@@ -82,10 +82,12 @@ Survey ReadSurvey(const YamlMap& map, std::uint64_t scenario_seed) {
 
 CalibrationError ReadCalibrationError(const YamlMap& map) {
   CalibrationError e;
-  e.focal_relative = map.NumberOr("focal_relative", 0.0, 0.0, 0.5);
-  e.principal_point_px = map.NumberOr("principal_point_px", 0.0, 0.0, 100.0, "px");
-  e.rotation_deg = map.NumberOr("rotation_deg", 0.0, 0.0, 30.0, "deg");
-  e.translation_m = map.NumberOr("translation_m", 0.0, 0.0, 0.5, "m");
+  e.focal_relative = map.NumberOr("focal_relative", e.focal_relative, 0.0, 0.5);
+  e.principal_point_px = map.NumberOr("principal_point_px", e.principal_point_px, 0.0, 100.0, "px");
+  e.rotation_deg = map.NumberOr("rotation_deg", e.rotation_deg, 0.0, 30.0, "deg");
+  e.translation_m = map.NumberOr("translation_m", e.translation_m, 0.0, 0.5, "m");
+  e.camera_imu_time_offset_s = map.NumberOr("camera_imu_time_offset_s", e.camera_imu_time_offset_s, 0.0, 1.0, "s");
+  e.seed = ReadSeed(map, e.seed);
   map.RejectUnknownKeys();
   return e;
 }
@@ -116,6 +118,7 @@ void ReadVisualMap(const YamlMap& root, Scenario& s) {
   recipe.survey_rotation_sigma_deg =
       spec.NumberOr("survey_rotation_sigma_deg", recipe.survey_rotation_sigma_deg, 0.0, 10.0, "deg");
   spec.RejectUnknownKeys();
+  recipe.calibration_error = s.calibration_error;  // the map is built with the robot's calibration
   s.visual_map_recipe = recipe;
 }
 
@@ -184,6 +187,7 @@ void ReadPlant(const YamlMap& root, Scenario& s) {
     const YamlMap cameras = root.Map("cameras");
     s.render_cameras = cameras.Bool("render", s.render_cameras);
     s.resolution_scale = cameras.NumberOr("resolution_scale", s.resolution_scale, 0.05, 1.0);
+    s.motion_blur = cameras.Bool("motion_blur", s.motion_blur);
     cameras.RejectUnknownKeys();
   }
   if (root.Has("noise")) {

@@ -58,14 +58,6 @@ struct Survey {
 
 // Errors of the calibration the stack reads (the simulator renders with the true one). Seeded
 // per trial; each a standard deviation.
-struct CalibrationError {
-  double focal_relative = 0.0;      // fx, fy scaled by (1 + e)
-  double principal_point_px = 0.0;  // cx, cy
-  double rotation_deg = 0.0;        // of each camera relative to cam0 (cam0's pose is the URDF's)
-  double translation_m = 0.0;       // of each camera relative to cam0
-  bool any() const { return focal_relative > 0 || principal_point_px > 0 || rotation_deg > 0 || translation_m > 0; }
-};
-
 // A goal of the mission: a point in the map frame, or a bush of the garden to approach for
 // trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff).
 struct ScenarioGoal {
@@ -119,6 +111,7 @@ struct Scenario {
   bool render_cameras = false;      // the whole ring on the camera schedule (~0.5-0.9 s a frame);
                                     // the stack's own requests are rendered regardless
   double resolution_scale = 0.5;    // of the scheduled ring (a request carries its own)
+  bool motion_blur = true;          // images blurred by the rig's motion over their exposure
   double imu_noise_scale = 1.0;
   double wheel_slip_scale = 1.0;
   SimulatedPoseFixParameters simulated_pose_fixes;  // test fixture, used when the stack asks for it

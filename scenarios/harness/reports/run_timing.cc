@@ -20,7 +20,10 @@ RunTiming MakeRunTiming(double wall_seconds, double simulated_seconds, const sim
               {"render_readback", "simulator", sim.render_readback, images, "camera image"},
               {"distortion", "simulator", sim.distortion, images, "camera image"},
               {"exposure_noise", "simulator", sim.exposure_noise, images, "camera image"},
-              {"ground_truth_images", "simulator", sim.ground_truth, 0, ""}};
+              {"depth_images", "simulator", sim.depth, 0, ""},
+              {"ground_truth_images", "simulator", sim.ground_truth, 0, ""},
+              {"motion_blur", "simulator", sim.motion_blur, images, "camera image"},
+              {"wind", "simulator", sim.wind, sim.ring_frames, "ring frame"}};
   if (stack != nullptr) {
     visual_localization::LocalizationTimings v;
     for (const auto& f : stack->visual_frames) {

@@ -128,8 +128,7 @@ int RunDrive(const DriveOptions& options) {
   const RunTiming timing =
       MakeRunTiming(wall, simulator.time(), sim_timing, &listener.telemetry().timings,
                     std::chrono::duration<double>(run_start - setup_start).count(), seconds(report_start));
-  const double render_seconds = sim_timing.render_draw + sim_timing.render_readback + sim_timing.distortion +
-                                sim_timing.exposure_noise + sim_timing.ground_truth;
+  const double render_seconds = sim_timing.RenderSeconds();
   const double ms_per_frame = sim_timing.ring_frames > 0 ? 1000.0 * render_seconds / sim_timing.ring_frames : 0.0;
   WriteFileAtomically(out + "/timing.json", ToJson(timing).dump(2) + "\n");
   WriteRunTimingChart(out + "/timing.png", "where the drive's time went", timing);

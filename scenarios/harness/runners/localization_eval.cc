@@ -16,6 +16,7 @@
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
 #include "loop/pilots.h"
+#include "loop/prior_knowledge.h"
 #include "reports/localization_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/overrides.h"
@@ -105,7 +106,9 @@ std::unique_ptr<VisualLocalizer> MakeLocalizer(const LocalizationEvalOptions& op
   }
   *drive = options.drive;
   if (!drive->resolution_scale) drive->resolution_scale = parameters.visual.image_scale;
-  return stack::MakeVisualLocalizer(options.map_path, parameters.visual, robot::LoadCameraRig(files));
+  // The robot's calibration, as `trimbot map build` makes maps with it (loop/map_recipe.h).
+  return stack::MakeVisualLocalizer(options.map_path, parameters.visual,
+                                    CalibratedRig(robot::LoadCameraRig(files), CalibrationError{}));
 }
 
 // The true position plus seeded noise: what the EKF would offer as the retrieval prior.

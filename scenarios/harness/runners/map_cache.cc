@@ -182,6 +182,10 @@ std::string MapCacheKey(const MapRecipe& recipe, const ProjectPaths& paths) {
       << "urdf " << Hex(Fnv1a(ReadBytes(robot.urdf))) << "\n"
       << "camchain " << Hex(Fnv1a(YamlContent(robot.camchain))) << "\n"
       << "robot parameters " << Hex(Fnv1a(YamlContent(robot.robot_parameters))) << "\n";
+  const CalibrationError& c = recipe.calibration_error;
+  key << "calibration error " << Number(c.focal_relative) << " " << Number(c.principal_point_px) << " "
+      << Number(c.rotation_deg) << " " << Number(c.translation_m) << " " << Number(c.camera_imu_time_offset_s)
+      << " seed " << c.seed << "\n";
   // The log builder's odometry runs the stack's EKF (its gyro bias).
   if (recipe.builder == visual_localization::KeyframePoses::kOdometry) {
     const stack::EkfParameters e = stack::StackParameters::Load(robot.stack_parameters).ekf;

@@ -108,14 +108,16 @@ class LogRecorder : public Observer {
   bool demanded_ = false;
 };
 
-// Mean position error (m) of the map's keyframes against the ground truth at their stamps.
-nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const SurveyPoses& survey) {
+// Mean position error (m) of the map's keyframes against the ground truth at their exposures
+// (the images' stamps are `camera_time_offset` s after them).
+nlohmann::json KeyframeErrors(const visual_localization::VisualMap& map, const SurveyPoses& survey,
+                              double camera_time_offset) {
   std::vector<double> adjusted, surveyed;
   for (const auto& k : map.keyframes) {
-    const auto truth = survey.truth().find(k.stamp);
-    if (truth == survey.truth().end()) continue;
+    const auto truth = survey.truth().lower_bound(k.stamp - camera_time_offset - 1e-6);
+    if (truth == survey.truth().end() || truth->first > k.stamp - camera_time_offset + 1e-6) continue;
     adjusted.push_back((k.T_map_base.translation() - truth->second.translation()).norm());
-    surveyed.push_back((survey.poses().at(k.stamp).translation() - truth->second.translation()).norm());
+    surveyed.push_back((survey.poses().at(truth->first).translation() - truth->second.translation()).norm());
   }
   return {{"survey_position_error_mean_m", ErrorStats::From(surveyed).mean},
           {"adjusted_position_error_mean_m", ErrorStats::From(adjusted).mean}};
@@ -291,18 +293,26 @@ visual_localization::MapBuilderOptions MapBuilderOptionsFor(const MapRecipe& rec
   return options;
 }
 
+// The mapping drive's simulator: only the keyframes are rendered; the robot's cameras keep their
+// clock offset.
+sim::SimulatorConfig MappingSimulatorConfig(const MapBuildOptions& options, const Setting& setting) {
+  sim::SimulatorConfig config =
+      MakeSimulatorConfig(options.paths, setting, LoadGarden(setting, options.paths), options.out_dir + "/world");
+  config.cameras_on_schedule = false;
+  config.camera_time_offset = CameraImuTimeOffset(options.recipe.calibration_error);
+  return config;
+}
+
 int RunMapBuild(const MapBuildOptions& options) {
   const auto wall_start = Clock::now();
   std::filesystem::create_directories(options.out_dir);
   const std::unique_ptr<MappingDrive> drive = LoadMappingDrive(options);
   const Setting& setting = drive->setting;
-  sim::SimulatorConfig config =
-      MakeSimulatorConfig(options.paths, setting, LoadGarden(setting, options.paths), options.out_dir + "/world");
-  config.cameras_on_schedule = false;  // only the keyframes are rendered
-  sim::Simulator simulator(config);
+  sim::Simulator simulator(MappingSimulatorConfig(options, setting));
 
-  // The map is made with the calibration the robot's stack reads (robot/), as the real one was.
-  const robot::CameraRig rig = robot::LoadCameraRig(options.paths.robot_files());
+  // The map is made with the calibration the robot's stack reads, as the real one was.
+  const robot::CameraRig rig =
+      CalibratedRig(robot::LoadCameraRig(options.paths.robot_files()), options.recipe.calibration_error);
   const visual_localization::MapBuilderOptions builder_options =
       MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(drive->descriptor));
   visual_localization::MapBuilder builder(rig, builder_options);
@@ -363,7 +373,8 @@ int RunMapBuild(const MapBuildOptions& options) {
                                           setting.conditions.growth, options.out_dir);
     report["seconds"]["evaluation"] = std::chrono::duration<double>(Clock::now() - evaluation_start).count();
   } else {
-    report["keyframes_against_ground_truth"] = KeyframeErrors(map, survey);
+    report["keyframes_against_ground_truth"] =
+        KeyframeErrors(map, survey, CameraImuTimeOffset(options.recipe.calibration_error));
   }
   WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
   std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "

@@ -43,6 +43,8 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   config.extra_objects = scenario.survey.unmapped_objects;
   config.imu_noise_scale = scenario.imu_noise_scale;
   config.wheel_slip_scale = scenario.wheel_slip_scale;
+  config.motion_blur = scenario.motion_blur;
+  config.camera_time_offset = CameraImuTimeOffset(scenario.calibration_error);
   return config;
 }
 
@@ -68,7 +70,7 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   result.index = setup.index;
   result.seed = setup.seed;
   robot::RobotFiles files = setup.paths.robot_files();
-  files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
+  files.camchain = StackCalibration(scenario, setup.paths, setup.dir);
   const stack::StackParameters& parameters = setup.prepared->stack_parameters;
   sim::Simulator simulator(PlantFor(setup, /*render_for_stack=*/true));
   const Eigen::Isometry3d T_map_base = simulator.ground_truth().T_map_base;
@@ -135,7 +137,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
 
   // The robot's side, from its own files and what the operator knows; never from the simulator.
   robot::RobotFiles files = setup.paths.robot_files();
-  files.camchain = StackCalibration(scenario, setup.paths, setup.seed, setup.dir);
+  files.camchain = StackCalibration(scenario, setup.paths, setup.dir);
   const stack::StackParameters& parameters = setup.prepared->stack_parameters;
   const bool visual = parameters.localization == stack::LocalizationSource::kVisual;
   const std::vector<stack::Goal>& mission = setup.prepared->mission;

@@ -23,15 +23,20 @@ struct WheelEncoderConfig {
 
 // The sensors' automatic exposure (AEC/AGC): per image, the exposure brings the mean grey level
 // of the metering window (the rows below `metering_top`, a fraction of the height: the ground, not
-// the sky) to `target_mean`; by exposure time first (up to `max_exposure_factor` times the
-// rendered daylight exposure, down to its inverse; no extra noise), then by analogue gain (up to
-// `max_gain`, which amplifies the read noise too).
+// the sky) to `target_mean`; by exposure time first (between `min_exposure_time` and
+// `max_exposure_time`; the rendered daylight scene is exposed for `daylight_exposure_time`), then
+// by analogue gain (up to `max_gain`, which amplifies the read noise too). The exposure time also
+// sets the motion blur.
 struct AutoExposure {
   bool enabled = true;
-  double target_mean = 100.0;  // grey levels
-  double metering_top = 0.4;   // 0..1
-  double max_exposure_factor = 4.0;
+  double target_mean = 100.0;              // grey levels
+  double metering_top = 0.4;               // 0..1
+  double daylight_exposure_time = 1.5e-4;  // s
+  double min_exposure_time = 3.2e-5;       // s
+  double max_exposure_time = 0.0153;       // s
   double max_gain = 4.0;
+  double max_exposure_factor() const { return max_exposure_time / daylight_exposure_time; }
+  double min_exposure_factor() const { return min_exposure_time / daylight_exposure_time; }
 };
 
 struct CameraTiming {

@@ -51,7 +51,13 @@ struct SimulatorConfig {
   bool frustum_culling = true;        // each camera draws only the geoms that can show in it (same image)
   double imu_noise_scale = 1.0;       // multiplies every IMU noise parameter
   double wheel_slip_scale = 1.0;      // multiplies the surfaces' slip (mean and spread)
-  std::vector<Fault> faults;          // injected at their times
+  // Motion blur: each image integrates the rig's motion over its exposure time (the auto
+  // exposure's, robot::AutoExposure). Wind and clouds are the conditions' (garden::Conditions).
+  bool motion_blur = true;
+  // The cameras' clock against the IMU's (s): images are stamped this much later than they were
+  // exposed (what a camera-IMU calibration leaves; the stack assumes 0).
+  double camera_time_offset = 0.0;
+  std::vector<Fault> faults;  // injected at their times
 };
 
 // What the robot's drivers deliver in one physics step.
@@ -123,7 +129,13 @@ struct SimulatorTimings {
   double render_readback = 0.0;  // pixels back from OpenGL
   double distortion = 0.0;       // pinhole render -> calibrated radtan camera (precomputed remap)
   double exposure_noise = 0.0;   // auto exposure and read noise
-  double ground_truth = 0.0;     // depth and label images, when asked for
+  double depth = 0.0;            // depth images (for ground truth and motion blur)
+  double ground_truth = 0.0;     // label images, when asked for
+  double motion_blur = 0.0;      // blurring the images by the rig's motion
+  double wind = 0.0;             // moving the plants' meshes for a frame
+  double RenderSeconds() const {
+    return render_draw + render_readback + distortion + exposure_noise + depth + ground_truth + motion_blur + wind;
+  }
   long physics_steps = 0;
   long ring_frames = 0;
   long camera_images = 0;
@@ -185,6 +197,9 @@ class Simulator {
   const garden::SlipModel* SurfaceUnder(int wheel_geom) const;
   // Applies the faults due at the current time; returns whether the cameras deliver images.
   bool ApplyFaults();
+  // The weather the cameras see: plants moved by the wind, the sun dimmed by clouds.
+  void SetUpWeather();
+  void SetWeatherFor(double t);
   std::vector<ObstacleContact> ObstacleContacts() const;
   std::vector<ArmContact> ArmContacts() const;
   void ReadSensors(double stamp_before, SensorOutputs* sensors);
