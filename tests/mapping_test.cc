@@ -201,11 +201,11 @@ TEST(MapBuild, AShortDriveGivesAConsistentMap) {
 
 // A frame of another run (other seed: other image noise) along the mapped path: the vocabulary
 // retrieves a keyframe within 1 m of the true pose, and the ring's pose comes out within a few
-// centimetres - with and without a pose prior.
+// centimetres - with and without a pose prior. (The robot's calibration, which the map was built
+// with, localizes.)
 TEST(MapBuild, RenderedFramesAreLocalizedAgainstTheMap) {
   const std::string dir = testing::TempDir("map_for_queries");
   ASSERT_EQ(scenarios::RunMapBuild(ShortLawnMap(dir)), 0);
-  // The robot's calibration, which the map was built with.
   const robot::CameraRig rig = scenarios::CalibratedRig(
       robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot"))), scenarios::CalibrationError{});
   const scenarios::DrivePlan plan =
