@@ -8,6 +8,7 @@
 #include "evaluation/comparison.h"
 #include "evaluation/statistics.h"
 #include "loop/scenario.h"
+#include "runners/ablation.h"
 #include "runners/batch.h"
 #include "runners/sweep.h"
 #include "test_support.h"
@@ -118,6 +119,85 @@ TEST(Compare, FlagsARealRegressionAndNotOtherSeeds) {
   json other = baseline;
   other["scenario"] = "rectangle";
   EXPECT_THROW(CompareBatches(baseline, "baseline", other, "other"), InputError);
+}
+
+// Every effect `trimbot ablate` switches off is on in the visual trial sets as written, and its
+// overrides turn exactly it off; the robot's own figures are read with the scenario.
+TEST(Ablate, EachEffectIsOnAsWrittenAndItsOverridesSwitchItOff) {
+  const std::string rectangle = testing::SourcePath("scenarios/navigation/rectangle_visual.yaml");
+  const Scenario all = Scenario::Load(rectangle);
+  const auto without = [&](const std::string& name) {
+    for (const auto& e : FidelityEffects()) {
+      if (e.name == name) return Scenario::Load(rectangle, ParseOverrides(e.off));
+    }
+    ADD_FAILURE() << "no effect " << name;
+    return all;
+  };
+  ASSERT_TRUE(all.visual_map_recipe.has_value());
+  EXPECT_EQ(all.visual_map_recipe->builder, visual_localization::KeyframePoses::kOdometry);
+  EXPECT_EQ(without("map_from_log").visual_map_recipe->builder, visual_localization::KeyframePoses::kSurveyed);
+  EXPECT_GT(all.setting.conditions.wind.mean_speed, 0.0);
+  EXPECT_EQ(without("wind").setting.conditions.wind.mean_speed, 0.0);
+  EXPECT_GT(all.setting.conditions.clouds.cover, 0.0);
+  EXPECT_EQ(without("clouds").setting.conditions.clouds.cover, 0.0);
+  EXPECT_EQ(without("clouds").setting.conditions.wind.mean_speed, all.setting.conditions.wind.mean_speed);
+  EXPECT_TRUE(all.motion_blur);
+  EXPECT_FALSE(without("motion_blur").motion_blur);
+  EXPECT_GT(all.calibration_error.rotation_deg, 0.0);
+  EXPECT_GT(all.calibration_error.camera_imu_time_offset_s, 0.0);
+  const CalibrationError exact = without("calibration_error").calibration_error;
+  EXPECT_EQ(exact.focal_relative + exact.principal_point_px + exact.rotation_deg + exact.translation_m +
+                exact.camera_imu_time_offset_s,
+            0.0);
+  EXPECT_EQ(without("calibration_error").visual_map_recipe->calibration_error.rotation_deg, 0.0)
+      << "the map is built with the calibration the robot reads";
+  ASSERT_TRUE(all.robot_reference.has_value());
+  EXPECT_EQ(all.robot_reference->metrics.at(1),
+            (std::pair<std::string, double>{"pose_fixes_position_error_mean_m", 0.0837}));  // D3.4 Table 3
+  EXPECT_THROW(Scenario::Load(rectangle, ParseOverrides({"robot_reference.metrics.speeed=1"})), InputError);
+  EXPECT_THROW(Scenario::Load(rectangle, ParseOverrides({"robot_reference.source=[]"})), InputError);
+}
+
+// A summary of six trials whose visual fixes are off by `fix_m` (+ i mm in trial i).
+json SyntheticSummary(double fix_m) {
+  json summary{{"scenario", "rectangle_visual"}, {"trials_planned", 6}};
+  std::vector<double> pooled;
+  for (int i = 0; i < 6; ++i) {
+    const std::vector<double> errors = {fix_m + 1e-3 * i, fix_m + 1e-3 * i};
+    pooled.insert(pooled.end(), errors.begin(), errors.end());
+    summary["trials"].push_back({{"success", true},
+                                 {"simulated_seconds", 100.0},
+                                 {"localization_rate", 1.0},
+                                 {"estimates", json::array({{{"name", "pose_fixes"}, {"position_m", errors}}})}});
+  }
+  summary["metrics"] = {{"pose_fixes_position_error_mean_m", Mean(pooled)},
+                        {"pose_fixes_position_error_median_m", Mean(pooled)},
+                        {"localization_rate", 1.0}};
+  return summary;
+}
+
+// The table sets the robot's figures beside the twin's, and marks an effect whose removal makes the
+// fixes better beyond trial-to-trial noise.
+TEST(Ablate, TheTableSetsTheRobotBesideTheTwinWithTheComparisonsVerdicts) {
+  ScenarioAblation a;
+  a.scenario = "rectangle_visual";
+  a.robot = Scenario::Load(testing::SourcePath("scenarios/navigation/rectangle_visual.yaml")).robot_reference;
+  a.batches.push_back({"", SyntheticSummary(0.05), nullptr, std::nullopt});
+  for (const auto& [effect, fix_m] : {std::pair{"wind", 0.02}, {"clouds", 0.05}}) {
+    AblationBatch b{effect, SyntheticSummary(fix_m), nullptr, std::nullopt};
+    b.against_all = CompareBatches(a.batches.front().summary, "all", b.summary, effect);
+    a.batches.push_back(b);
+  }
+  const std::string md = TwinVersusRobotMarkdown({a});
+  EXPECT_NE(md.find("| the robot | 100.0 % | 8.37 / 6.37 cm | 12.24 / 10.54 cm | 92.3 % | - | 150 ms | - |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| twin, every effect on | 6/6 | 5.25 / 5.25 cm |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| without wind | 6/6 (=) | 2.25 / 2.25 cm **better** (p 0.0011) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| without clouds | 6/6 (=) | 5.25 / 5.25 cm (=) |"), std::string::npos) << md;
+  const json j = TwinVersusRobotJson({a});
+  EXPECT_EQ(j[0]["batches"].size(), 3u);
+  EXPECT_EQ(j[0]["robot"]["metrics"]["ekf_position_error_mean_m"], 0.1224);
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ void AddGardenCommands(Commands& commands);        // garden import-csv | genera
 void AddBatchCommands(Commands& commands);         // run, merge
 void AddRegistrationCommands(Commands& commands);  // register, register-set
 void AddCompareCommand(Commands& commands);
-void AddTuningCommands(Commands& commands);  // sweep, tune
+void AddTuningCommands(Commands& commands);  // sweep, tune, ablate
 void AddMapCommands(Commands& commands);     // map build | ensure | bench | retrieval-eval
 void AddFusionCommand(Commands& commands);
 void AddStereoCommand(Commands& commands);

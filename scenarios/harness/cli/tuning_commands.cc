@@ -1,5 +1,5 @@
-// `trimbot sweep` and `trimbot tune`: parameter sweeps and derivative-free tuning of a scenario
-// (runners/sweep.h, runners/tune.h).
+// `trimbot sweep`, `trimbot tune` and `trimbot ablate`: parameter sweeps, derivative-free tuning
+// and the fidelity effects switched off in turn (runners/sweep.h, runners/tune.h, runners/ablation.h).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -7,6 +7,7 @@
 #include "cli/command.h"
 
 #include "cli/cluster_options.h"
+#include "runners/ablation.h"
 #include "runners/sweep.h"
 #include "runners/tune.h"
 
@@ -65,11 +66,27 @@ void AddTune(Commands& commands) {
   AddBatchOptionsAndRun(commands, tune, options, "evaluation", &RunTune);
 }
 
+void AddAblate(Commands& commands) {
+  auto options = std::make_shared<AblationOptions>();
+  auto* ablate = commands.app().add_subcommand(
+      "ablate",
+      "the twin beside the real robot: each scenario with every fidelity effect on, then each effect off in turn on "
+      "the same seeds, compared (twin_vs_robot.md)");
+  ablate->add_option("scenarios", options->scenario_paths, "scenario files (YAML)")->required();
+  std::string effects;
+  for (const auto& e : FidelityEffects()) effects += (effects.empty() ? "" : ", ") + e.name;
+  ablate->add_option("--effect", options->effects,
+                     "an effect to switch off (repeatable; default all: " + effects + ")");
+  ablate->add_option("--out", options->out_dir, "output folder (finished batches in it are reused)")->required();
+  AddBatchOptionsAndRun(commands, ablate, options, "batch", &RunAblation);
+}
+
 }  // namespace
 
 void AddTuningCommands(Commands& commands) {
   AddSweep(commands);
   AddTune(commands);
+  AddAblate(commands);
 }
 
 }  // namespace trimbot::scenarios

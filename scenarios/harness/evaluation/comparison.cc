@@ -36,8 +36,8 @@ std::vector<double> PerTrial(const json& summary, const Extractor& extract) {
   return values;
 }
 
-MetricComparison CompareValues(const std::string& metric, const std::string& unit, const std::vector<double>& a,
-                               const std::vector<double>& b) {
+MetricComparison CompareValues(const std::string& metric, const std::string& unit, bool higher_is_worse,
+                               const std::vector<double>& a, const std::vector<double>& b) {
   MetricComparison m;
   m.metric = metric;
   m.unit = unit;
@@ -46,15 +46,22 @@ MetricComparison CompareValues(const std::string& metric, const std::string& uni
   m.candidate = Mean(b);
   m.delta = m.candidate - m.baseline;
   m.delta_interval = BootstrapDifferenceInterval(a, b);
-  m.p_worse = MannWhitneyGreaterP(a, b);  // higher is worse for every such metric
-  m.p_better = MannWhitneyGreaterP(b, a);
+  m.p_worse = higher_is_worse ? MannWhitneyGreaterP(a, b) : MannWhitneyGreaterP(b, a);
+  m.p_better = higher_is_worse ? MannWhitneyGreaterP(b, a) : MannWhitneyGreaterP(a, b);
   return m;
 }
 
 struct PerTrialMetric {
   std::string name, unit;
   Extractor extract;
+  bool higher_is_worse = true;
 };
+
+// A visual-localization share of a trial (nullopt without visual localization).
+std::optional<double> VisualShare(const json& t, const char* key) {
+  if (!t.contains(key) || t[key].get<double>() < 0.0) return std::nullopt;
+  return t[key].get<double>();
+}
 
 const std::vector<PerTrialMetric>& PerTrialMetricTable() {
   static const std::vector<PerTrialMetric> table = {
@@ -62,6 +69,9 @@ const std::vector<PerTrialMetric>& PerTrialMetricTable() {
       {"ekf_position_error_m", "m", [](const json& t) { return TrialMean(t, "ekf", "position_m"); }},
       {"ekf_heading_error_deg", "deg", [](const json& t) { return TrialMean(t, "ekf", "heading_deg"); }},
       {"trial_seconds", "s", [](const json& t) { return std::optional<double>(t.value("simulated_seconds", 0.0)); }},
+      // The stack's own localization (trials with fixes only): what the robot's Tables 2 and 3 report.
+      {"pose_fix_position_error_m", "m", [](const json& t) { return TrialMean(t, "pose_fixes", "position_m"); }},
+      {"localization_rate", "", [](const json& t) { return VisualShare(t, "localization_rate"); }, false},
   };
   return table;
 }
@@ -112,7 +122,8 @@ Comparison CompareBatches(const json& baseline, const std::string& baseline_file
   c.metrics.push_back(CompareSuccess(baseline, candidate));
   for (const auto& metric : PerTrialMetricTable()) {
     const auto a = PerTrial(baseline, metric.extract), b = PerTrial(candidate, metric.extract);
-    if (!a.empty() && !b.empty()) c.metrics.push_back(CompareValues(metric.name, metric.unit, a, b));
+    if (!a.empty() && !b.empty())
+      c.metrics.push_back(CompareValues(metric.name, metric.unit, metric.higher_is_worse, a, b));
   }
   c.alpha_per_metric = alpha / static_cast<double>(c.metrics.size());
   for (auto& m : c.metrics) {

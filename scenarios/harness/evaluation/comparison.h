@@ -2,8 +2,9 @@
 // Regression check of a candidate batch against a baseline batch of the same scenario (their
 // summary.json): per metric the delta with a 95 % interval, a one-sided test in each direction,
 // and a verdict - regressed / improved / no evidence. Trials are the unit: success counts are
-// compared with Fisher's exact test, per-trial values (collisions, mean EKF errors, mission time)
-// with the Mann-Whitney U test. The level is split over the metrics (Bonferroni), so a re-run with
+// compared with Fisher's exact test, per-trial values (collisions, mean EKF errors, mission time,
+// and with localization fixes their mean error and the localization rate, where lower is worse) with
+// the Mann-Whitney U test. The level is split over the metrics (Bonferroni), so a re-run with
 // other seeds is flagged with probability at most `alpha` in all.
 #include <nlohmann/json.hpp>
 #include <string>

@@ -114,7 +114,13 @@ void TrialEvaluator::Observe(const StepView& step) {
   for (const auto& fix : fixes) {
     fix_stamps_.push_back(fix.stamp);
     fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
-    if (const PlanarPose* at = TruthAt(fix.stamp)) AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
+    const PlanarPose* at = TruthAt(fix.stamp);
+    if (at == nullptr) continue;
+    AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
+    // Is the fix's stated covariance what its error is? (NEES: 3 on average when it is.)
+    const Eigen::Vector3d error(fix.x - at->x, fix.y - at->y, AngleDifference(fix.yaw, at->yaw));
+    const double nees = error.dot(fix.covariance.ldlt().solve(error));
+    if (std::isfinite(nees)) fixes_.nees.push_back(nees);
   }
   if (have_previous_) path_length_ += std::hypot(truth.x - previous_.x, truth.y - previous_.y);
   previous_ = truth;

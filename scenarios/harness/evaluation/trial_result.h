@@ -161,7 +161,8 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 // visual_frame_rate_hz (frames attempted per simulated second), and per estimate
 // E (ekf, wheel_odometry, pose_fixes): E_position_error_{mean,median,max,rmse}_m and
 // E_heading_error_{mean,median,max}_deg over the pooled samples (absent when E has no samples), and for the
-// EKF its consistency: ekf_nees_mean (3 when consistent) and ekf_nees_within_95_rate (0.95 when consistent);
+// EKF and the pose fixes their consistency against their stated covariances: E_nees_mean (3 when
+// consistent) and E_nees_within_95_rate (0.95 when consistent);
 // with bush goals: bush_goals, bush_{distance,bearing}_error_{mean,max} (final pose, absolute,
 // m / deg), bush_estimate_{distance,bearing}_error_{mean,max} (the stack's final estimate), and
 // over the frames at 1-3 m: bush_frames_1_3m, bush_frame_found_rate, bush_frame_{distance,

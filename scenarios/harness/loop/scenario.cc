@@ -46,6 +46,7 @@ sim::Fault ReadFault(const YamlMap& item) {
 SimulatedPoseFixParameters ReadSimulatedPoseFixes(const YamlMap& map) {
   SimulatedPoseFixParameters p;
   p.availability = map.NumberOr("availability", p.availability, 0.0, 1.0);
+  p.outage_mean_duration = map.NumberOr("outage_mean_duration", p.outage_mean_duration, 0.0, 3600.0, "s");
   p.position_sigma = map.NumberOr("position_sigma", p.position_sigma, 0.0, 100.0, "m");
   p.yaw_sigma = map.NumberOr("yaw_sigma_deg", p.yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
   p.latency_median = map.NumberOr("latency_median", p.latency_median, 1e-3, 60.0, "s");
@@ -222,6 +223,22 @@ void ReadCriteria(const YamlMap& criteria, Scenario& s) {
   criteria.RejectUnknownKeys();
 }
 
+RobotReference ReadRobotReference(const YamlMap& map) {
+  RobotReference reference;
+  reference.source = map.String("source");
+  if (map.Has("frame_seconds")) reference.frame_seconds = map.Number("frame_seconds", 1e-6, 1e3, "s");
+  const YamlMap metrics = map.Map("metrics");
+  for (const auto& entry : metrics.node()) {
+    const std::string metric = entry.first.as<std::string>();
+    if (!IsKnownMetric(metric)) metrics.Fail(metric, "unknown metric");
+    reference.metrics.emplace_back(metric, metrics.Number(metric, 0.0, 1e12));  // every metric is >= 0
+  }
+  metrics.RejectUnknownKeys();
+  if (reference.metrics.empty()) map.Fail("metrics", "needs at least one of the robot's figures");
+  map.RejectUnknownKeys();
+  return reference;
+}
+
 }  // namespace
 
 bool IsKnownMetric(const std::string& name) {
@@ -229,7 +246,8 @@ bool IsKnownMetric(const std::string& name) {
     std::set<std::string> names = {"success_rate",       "goal_success_rate", "trials_completed",
                                    "collisions",         "recoveries",        "mean_trial_seconds",
                                    "mean_path_length_m", "localization_rate", "min_clearance_m"};
-    names.insert({"visual_frame_success_rate", "visual_frame_rate_hz", "ekf_nees_mean", "ekf_nees_within_95_rate"});
+    names.insert({"visual_frame_success_rate", "visual_frame_rate_hz", "ekf_nees_mean", "ekf_nees_within_95_rate",
+                  "pose_fixes_nees_mean", "pose_fixes_nees_within_95_rate"});
     names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
     names.insert({"arm_goals", "arm_success_rate", "arm_contacts", "arm_tracking_error_max_rad", "arm_min_clearance_m",
                   "arm_position_error_mean_m", "arm_position_error_max_m", "arm_orientation_error_mean_deg",
@@ -280,6 +298,7 @@ Scenario Scenario::Load(const std::string& path, const std::vector<Override>& ov
   ReadPlant(root, s);
   if (root.Has("stack")) s.stack = root.Map("stack");
   if (root.Has("criteria")) ReadCriteria(root.Map("criteria"), s);
+  if (root.Has("robot_reference")) s.robot_reference = ReadRobotReference(root.Map("robot_reference"));
   root.RejectUnknownKeys();
   return s;
 }

@@ -83,6 +83,16 @@ struct ArmReach {
   int renders = 3;                                    // PNGs of the first poses reached
 };
 
+// The real robot's figures for the experiment a scenario mirrors (`robot_reference:`), set beside
+// the twin's in the twin-versus-robot report (`trimbot ablate`). Never a pass criterion by itself:
+// criteria say what must hold, this says what the robot measured.
+struct RobotReference {
+  std::string source;  // where the figures come from (document, table)
+  // Batch metrics as summary.json names them (IsKnownMetric), in the order given.
+  std::vector<std::pair<std::string, double>> metrics;
+  double frame_seconds = -1.0;  // typical processing time of a localization frame (s); -1: not given
+};
+
 struct Scenario {
   std::string source;  // file it was read from
   std::string name;
@@ -118,6 +128,7 @@ struct Scenario {
   bool simulated_pose_fixes_given = false;          // the file set them (then the stack must use them)
   std::vector<sim::Fault> faults;
   std::vector<PassCriterion> criteria;
+  std::optional<RobotReference> robot_reference;
   std::optional<YamlMap> stack;        // overrides of robot/config/stack.yaml
   std::vector<std::string> overrides;  // --set key=value, as given (recorded with the results)
   std::string effective_yaml;          // the file with the overrides applied (a batch's scenario.yaml)

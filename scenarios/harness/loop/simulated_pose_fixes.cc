@@ -8,6 +8,20 @@ namespace trimbot::scenarios {
 SimulatedPoseFixes::SimulatedPoseFixes(const SimulatedPoseFixParameters& parameters, std::uint64_t seed)
     : parameters_(parameters), rng_(MakeRng(seed, "pose_fixes")) {}
 
+bool SimulatedPoseFixes::InOutage(double stamp, double u) {
+  const double outage_share = 1.0 - parameters_.availability;
+  // Exact transition of the two-state process over the time since the last frame: it relaxes to
+  // the stationary share at rate (1/duration) / availability (the sum of both switching rates).
+  double p_outage = outage_share;
+  if (outage_state_stamp_ >= 0.0 && parameters_.outage_mean_duration > 0.0 && parameters_.availability > 0.0) {
+    const double rate = 1.0 / (parameters_.outage_mean_duration * parameters_.availability);
+    p_outage += ((in_outage_ ? 1.0 : 0.0) - outage_share) * std::exp(-rate * (stamp - outage_state_stamp_));
+  }
+  in_outage_ = u < p_outage;
+  outage_state_stamp_ = stamp;
+  return in_outage_;
+}
+
 void SimulatedPoseFixes::Capture(double stamp, double x, double y, double yaw) {
   // Every draw happens for every frame, so one parameter change does not reshuffle the others.
   const double u_available = UniformUnit(rng_);
@@ -18,11 +32,13 @@ void SimulatedPoseFixes::Capture(double stamp, double x, double y, double yaw) {
       parameters_.outlier_min + (parameters_.outlier_max - parameters_.outlier_min) * UniformUnit(rng_);
   const double outlier_direction = 2.0 * M_PI * UniformUnit(rng_);
 
+  const bool in_outage = InOutage(stamp, u_available);  // the outage process runs whether or not a frame is processed
+
   if (stamp < busy_until_) return;  // still processing the previous frame
   const double latency = std::min(parameters_.latency_max,
                                   parameters_.latency_median * std::exp(parameters_.latency_log_sigma * n_latency));
   busy_until_ = stamp + latency;
-  if (u_available >= parameters_.availability) return;  // not localized in this frame
+  if (in_outage) return;  // not localized in this frame
 
   messages::PoseFix fix;
   fix.stamp = stamp;
