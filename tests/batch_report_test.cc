@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 
+#include "evaluation/localization_log.h"
 #include "evaluation/trial_evaluator.h"
 #include "evaluation/trial_result.h"
 #include "reports/batch_report.h"
@@ -122,6 +123,8 @@ TEST(TrialResultJson, RoundTripIsLossless) {
   trial.fixes_rejected = 3;
   trial.relocalizations = 1;
   trial.visual_frames_attempted = 57;
+  trial.visual_frame_outcomes = {{"accepted", 50}, {"no pose: matching", 7}};
+  trial.localization_stopped_updates = 12;
   trial.faults = {"camera 3 dropped at 20 s", "wheel slip 10 %"};
   trial.estimates = {Estimate("ekf", {0.1, 0.2, 1e-17, 0.30000000000000004}, {0.5, 179.9}),
                      Estimate("pose_fixes", {}, {})};
@@ -517,6 +520,40 @@ TEST(RunTiming, StagesAccountForTheWallTimeAndAddUpOverTrials) {
 
 // Clearance is measured with the base's outline at the true pose against the garden as it is:
 // positive before an obstacle, negative as deep as the outline reaches into it.
+// Every frame the localizer tried is logged at its true pose with what came of it: no pose (the
+// stage), or the fix's error, stated sigma and NEES with the EKF's verdict; a fix that never
+// arrived stays pending.
+TEST(LocalizationLog, EachFrameWithItsOutcomeErrorAndConsistency) {
+  LocalizationLog log;
+  const TruePose truth{1.0, 2.0, 0.5};
+  stack::LocalizationAttempt failed{
+      10.0, visual_localization::FailedStage::kPose, "RANSAC found 12 inliers, 20 needed", 900, 60, 0};
+  stack::LocalizationAttempt localized{10.6, visual_localization::FailedStage::kNone, "", 1000, 300, 200};
+  stack::LocalizationAttempt late{11.2, visual_localization::FailedStage::kNone, "", 1000, 280, 190};
+  log.AddAttempt(failed, &truth);
+  log.AddAttempt(localized, &truth);
+  log.AddAttempt(late, &truth);
+  stack::AppliedFix fix;
+  fix.fix.stamp = 10.6;
+  fix.fix.x = 1.03;  // 3 cm off along x, at a stated 2 cm: NEES (3/2)^2 = 2.25
+  fix.fix.y = 2.0;
+  fix.fix.yaw = 0.5;
+  fix.fix.covariance = Eigen::Vector3d(0.02 * 0.02, 0.01 * 0.01, 0.01 * 0.01).asDiagonal();
+  fix.outcome = stack::FixOutcome::kRejectedOutlier;
+  log.AddFix(fix, &truth);
+  const auto outcomes = log.Outcomes();
+  EXPECT_EQ(outcomes.at("no pose: pose"), 1);
+  EXPECT_EQ(outcomes.at("rejected as an outlier"), 1);
+  EXPECT_EQ(outcomes.at("pending"), 1);
+  const std::string csv = log.Csv();
+  EXPECT_NE(csv.find("10.000,1.000,2.000,0.5000,no pose: pose,\"RANSAC found 12 inliers, 20 needed\",900,60,0,,,\n"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("10.600,1.000,2.000,0.5000,rejected as an outlier,\"\",1000,300,200,0.0300,0.0200,2.250\n"),
+            std::string::npos)
+      << csv;
+}
+
 TEST(TrialEvaluator, MeasuresClearanceOfTheBaseOutline) {
   garden::OccupancyMap world;
   world.resolution = 0.05;

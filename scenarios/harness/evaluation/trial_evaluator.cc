@@ -109,8 +109,19 @@ void TrialEvaluator::Observe(const StepView& step) {
   }
   // Fixes of the simulated fixture, and the stack's own visual fixes as they reach its EKF.
   std::vector<messages::PoseFix> fixes = step.pose_fixes;
-  if (step.telemetry != nullptr)
-    fixes.insert(fixes.end(), step.telemetry->visual_fixes.begin(), step.telemetry->visual_fixes.end());
+  if (step.telemetry != nullptr) {
+    for (const auto& attempt : step.telemetry->visual_attempts) {
+      const PlanarPose* at = TruthAt(attempt.stamp);
+      const TruePose truth = at != nullptr ? TruePose{at->x, at->y, at->yaw} : TruePose{};
+      localization_log_.AddAttempt(attempt, at != nullptr ? &truth : nullptr);
+    }
+    for (const auto& applied : step.telemetry->visual_fixes) {
+      fixes.push_back(applied.fix);
+      const PlanarPose* at = TruthAt(applied.fix.stamp);
+      const TruePose truth = at != nullptr ? TruePose{at->x, at->y, at->yaw} : TruePose{};
+      localization_log_.AddFix(applied, at != nullptr ? &truth : nullptr);
+    }
+  }
   for (const auto& fix : fixes) {
     fix_stamps_.push_back(fix.stamp);
     fixes_tum_ += Tum(fix.stamp, {fix.x, fix.y, fix.yaw});
@@ -247,6 +258,8 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   result->bush_frames = bush_frames_;
   result->localization_rate = LocalizationRate();
   result->visual_frames_attempted = telemetry.visual.attempts;
+  result->visual_frame_outcomes = localization_log_.Outcomes();
+  result->localization_stopped_updates = telemetry.visual.stopped_updates;
   const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
   result->success = result->status == "completed" && all_reached && collisions_ == 0;
   if (result->status == "completed" && !result->success) {
@@ -273,6 +286,7 @@ void TrialEvaluator::WriteFiles(const std::string& dir) const {
   WriteFileAtomically(dir + "/ekf.tum", ekf_tum_);
   WriteFileAtomically(dir + "/wheel_odometry.tum", odometry_tum_);
   WriteFileAtomically(dir + "/pose_fixes.tum", fixes_tum_);
+  if (!localization_log_.empty()) WriteFileAtomically(dir + "/localization.csv", localization_log_.Csv());
   WriteFileAtomically(dir + "/events.csv", events_csv_);
   if (!bush_frames_.empty()) {
     std::ostringstream csv;

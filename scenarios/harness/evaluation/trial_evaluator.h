@@ -5,7 +5,8 @@
 // arrived), replans and recoveries from the stack's events. Writes ground_truth.tum, ekf.tum,
 // wheel_odometry.tum, pose_fixes.tum (TUM, usable with evo) and events.csv. Bush goals: the arm's
 // true distance and bearing to the bush's true centre at arrival against the stack's target and
-// its own estimate, and every frame the stack looked for the bush (bush_frames.csv).
+// its own estimate, and every frame the stack looked for the bush (bush_frames.csv). With the
+// stack's visual localization, every frame it tried and what came of it (localization.csv).
 #include <Eigen/Core>
 #include <deque>
 #include <limits>
@@ -15,6 +16,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "evaluation/localization_log.h"
 #include "evaluation/trial_result.h"
 #include "loop/closed_loop.h"
 #include "loop/prepared_trial.h"
@@ -74,6 +76,7 @@ class TrialEvaluator : public Observer {
   std::vector<BushFrame> bush_frames_;
   EstimateErrors ekf_{"ekf", {}, {}}, odometry_{"wheel_odometry", {}, {}}, fixes_{"pose_fixes", {}, {}};
   std::string truth_tum_, ekf_tum_, odometry_tum_, fixes_tum_;
+  LocalizationLog localization_log_;  // the stack's own visual localization, frame by frame
   std::string events_csv_ = "t,event,goal,detail\n";
   std::deque<PlanarPose> truth_history_;  // the last seconds, to judge late fixes at their stamps
   bool have_previous_ = false;

@@ -120,6 +120,10 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
        {"faults", t.faults},
        {"estimates", t.estimates}};
   if (t.min_clearance_m) j["min_clearance_m"] = *t.min_clearance_m;
+  if (t.visual_frames_attempted > 0) {
+    j["visual_frame_outcomes"] = t.visual_frame_outcomes;
+    j["localization_stopped_updates"] = t.localization_stopped_updates;
+  }
   if (!t.bush_frames.empty()) j["bush_frames"] = t.bush_frames;
   if (!t.arm_goals.empty()) {
     j["arm_goals"] = t.arm_goals;
@@ -145,6 +149,8 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
   j.at("relocalizations").get_to(t.relocalizations);
   t.localization_rate = j.value("localization_rate", -1.0);
   t.visual_frames_attempted = j.value("visual_frames_attempted", 0);
+  if (j.contains("visual_frame_outcomes")) j.at("visual_frame_outcomes").get_to(t.visual_frame_outcomes);
+  t.localization_stopped_updates = j.value("localization_stopped_updates", 0);
   j.at("faults").get_to(t.faults);
   j.at("estimates").get_to(t.estimates);
   if (j.contains("min_clearance_m")) t.min_clearance_m = j.at("min_clearance_m").get<double>();

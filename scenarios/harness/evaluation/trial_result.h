@@ -3,6 +3,7 @@
 // trials/NNN/result.json by the process that ran it); a batch (one run, or shards merged) turns
 // the trial results into a BatchSummary with the scenario's pass criteria evaluated.
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -112,6 +113,10 @@ struct TrialResult {
   // Ring frames the stack's visual localizer tried (0: it did not run). With fixes_accepted, the
   // per-frame success the localization rate hides: at 2 Hz one fix covers a whole second.
   int visual_frames_attempted = 0;
+  // Those frames by what came of them (LocalizationLog::Outcomes), and the control updates the
+  // robot stood still because its position was too uncertain to drive on.
+  std::map<std::string, int> visual_frame_outcomes;
+  int localization_stopped_updates = 0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
   std::vector<BushFrame> bush_frames;        // bush goals' sightings

@@ -185,6 +185,7 @@ messages::RobotCommands RobotStack::Update(double stamp) {
   telemetry_.events.clear();
   telemetry_.registration = components_->fusion.TakeRegistration();
   telemetry_.bush_sightings = components_->bush.TakeSightings();
+  telemetry_.visual_attempts = components_->visual.TakeAttempts();
   telemetry_.arm_results.clear();
   components_->visual.DeliverFixes(stamp, &state.ekf, &telemetry_);
   if (stamp + 1e-9 >= next_control_) {

@@ -47,6 +47,8 @@ void VisualLocalizationComponent::Consume(const messages::RingFrame& frame, Stac
   next_frame_ = frame.stamp + 1.0 / v.rate_hz;
   ++telemetry->visual.attempts;
   telemetry->timings.visual_frames.push_back(result.timings);
+  attempts_.push_back(
+      {frame.stamp, result.failed_stage, result.failure, result.features, result.matches, result.inliers});
   if (!result.success) {
     ++telemetry->visual.failures;
     return;
@@ -69,11 +71,12 @@ void VisualLocalizationComponent::DeliverFixes(double stamp, Ekf* ekf, Telemetry
       ++it;
       continue;
     }
+    FixOutcome outcome;
     {
       ScopedTimer timer(&telemetry->timings.ekf);
-      ekf->AddPoseFix(it->fix);
+      outcome = ekf->AddPoseFix(it->fix);
     }
-    telemetry->visual_fixes.push_back(it->fix);
+    telemetry->visual_fixes.push_back({it->fix, outcome});
     it = pending_fixes_.erase(it);
   }
 }

@@ -4,6 +4,7 @@
 // measured, and the localizer works on one frame at a time).
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "ring_component.h"
@@ -31,6 +32,8 @@ class VisualLocalizationComponent : public RingComponent {
   void DeliverFixes(double stamp, Ekf* ekf, Telemetry* telemetry);
   // Localization is visual and the estimate's position is too uncertain to drive on.
   bool Lost(const Ekf& ekf) const;
+  // The frames localized since the last call, and what came of each.
+  std::vector<LocalizationAttempt> TakeAttempts() { return std::exchange(attempts_, {}); }
 
  private:
   struct PendingFix {
@@ -42,6 +45,7 @@ class VisualLocalizationComponent : public RingComponent {
   std::unique_ptr<visual_localization::VisualLocalizer> localizer_;
   Rng latency_rng_;
   std::vector<PendingFix> pending_fixes_;  // still "being computed"
+  std::vector<LocalizationAttempt> attempts_;
   double busy_until_ = -1.0;
   double next_frame_ = 0.0;
 };

@@ -212,6 +212,22 @@ std::vector<int> VisualLocalizer::cameras() const {
   return all;
 }
 
+const char* ToString(FailedStage stage) {
+  switch (stage) {
+    case FailedStage::kNone:
+      return "";
+    case FailedStage::kFeatures:
+      return "features";
+    case FailedStage::kRetrieval:
+      return "retrieval";
+    case FailedStage::kMatching:
+      return "matching";
+    case FailedStage::kPose:
+      return "pose";
+  }
+  return "";
+}
+
 LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
                                              const std::optional<Eigen::Vector2d>& prior_position) {
   LocalizationResult result;
@@ -225,8 +241,9 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   result.retrieved = Retrieve(features, prior_position, options_.retrieval, options_.keyframes);
   result.timings.retrieval = Since(start);
   if (features.descriptors.rows < options_.pose.min_inliers || result.retrieved.empty()) {
-    result.failure =
-        features.descriptors.rows < options_.pose.min_inliers ? "too few features" : "no keyframe retrieved";
+    const bool few_features = features.descriptors.rows < options_.pose.min_inliers;
+    result.failure = few_features ? "too few features" : "no keyframe retrieved";
+    result.failed_stage = few_features ? FailedStage::kFeatures : FailedStage::kRetrieval;
     return result;
   }
   start = Clock::now();
@@ -238,6 +255,8 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   result.timings.pose = Since(start);
   if (!pose.success) {
     result.failure = pose.failure;
+    result.failed_stage =
+        result.matches < std::max(options_.pose.min_inliers, 3) ? FailedStage::kMatching : FailedStage::kPose;
     return result;
   }
   result.success = true;

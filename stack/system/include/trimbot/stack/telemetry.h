@@ -38,6 +38,20 @@ struct StackTimings {
   std::vector<visual_localization::LocalizationTimings> visual_frames;
 };
 
+// A ring frame the stack's visual localization worked on, and what came of it.
+struct LocalizationAttempt {
+  double stamp = 0.0;                                                                       // the frame's
+  visual_localization::FailedStage failed_stage = visual_localization::FailedStage::kNone;  // kNone: a pose
+  std::string failure;                                                                      // why not, in words
+  int features = 0, matches = 0, inliers = 0;
+};
+
+// A pose fix of the stack's own localization as it reached the EKF, with the EKF's verdict.
+struct AppliedFix {
+  messages::PoseFix fix;
+  FixOutcome outcome = FixOutcome::kAccepted;
+};
+
 // The stack's own visual localization, counted.
 struct VisualLocalizationCounters {
   int attempts = 0;         // ring frames localized
@@ -98,7 +112,8 @@ struct Telemetry {
   int ring_frames = 0;                                        // received
   int pose_fixes_ignored = 0;                                 // received while no fix source is configured
   std::optional<perception::CloudRegistration> registration;  // local fusion, in the last update
-  std::vector<messages::PoseFix> visual_fixes;                // the stack's own fixes applied in the last update
+  std::vector<AppliedFix> visual_fixes;              // the stack's own fixes that reached the EKF in the last update
+  std::vector<LocalizationAttempt> visual_attempts;  // frames localized since the last update
   VisualLocalizationCounters visual;
   ObstacleCounters obstacles;
   std::vector<BushSighting> bush_sightings;     // looked for in the frames since the last update

@@ -41,6 +41,10 @@ struct LocalizationTimings {
   double features = 0.0, retrieval = 0.0, matching = 0.0, pose = 0.0;  // wall-clock seconds
 };
 
+// Where a frame that gave no pose failed.
+enum class FailedStage { kNone, kFeatures, kRetrieval, kMatching, kPose };
+const char* ToString(FailedStage stage);  // "", "features", "retrieval", "matching", "pose"
+
 struct LocalizationResult {
   bool success = false;
   double stamp = 0.0;
@@ -49,7 +53,8 @@ struct LocalizationResult {
   std::vector<int> retrieved;                                       // keyframe ids, best first
   int features = 0, matches = 0, inliers = 0;
   LocalizationTimings timings;
-  std::string failure;
+  std::string failure;  // why no pose, in words
+  FailedStage failed_stage = FailedStage::kNone;
 };
 
 class VisualLocalizer {
