@@ -78,6 +78,7 @@ void AddAblate(Commands& commands) {
   ablate->add_option("--effect", options->effects,
                      "an effect to switch off (repeatable; default all: " + effects + ")");
   ablate->add_option("--out", options->out_dir, "output folder (finished batches in it are reused)")->required();
+  ablate->add_flag("--report-only", options->report_only, "run nothing: the table of the batches finished so far");
   AddBatchOptionsAndRun(commands, ablate, options, "batch", &RunAblation);
 }
 

@@ -252,19 +252,25 @@ int RunAblation(const AblationOptions& options) {
   const std::vector<PlannedBatch> planned = PlanBatches(options, effects, &ablations);
   fs::create_directories(options.out_dir);
   std::vector<BatchOptions> to_run;
+  std::vector<bool> finished;
   for (const auto& p : planned) {
-    if (FinishedBatch(p.options, p.scenario_as_run)) {
+    finished.push_back(FinishedBatch(p.options, p.scenario_as_run));
+    if (finished.back())
       std::cout << "[ablate] reusing " << p.options.out_dir << std::endl;
-    } else {
+    else if (options.report_only)
+      std::cout << "[ablate] not run yet, left out: " << p.options.out_dir << std::endl;
+    else
       to_run.push_back(p.options);
-    }
   }
   std::cout << "[ablate] " << planned.size() << " batches, " << to_run.size() << " to run -> " << options.out_dir
             << std::endl;
   RunBatches(options.executor, to_run,
              [&](std::size_t i) { std::cout << "[ablate] done: " << to_run[i].out_dir << std::endl; });
   std::vector<std::string> baseline_dirs(options.scenario_paths.size());
-  for (const auto& p : planned) {
+  for (std::size_t i = 0; i < planned.size(); ++i) {
+    const PlannedBatch& p = planned[i];
+    if (options.report_only && !finished[i]) continue;
+    if (!p.effect.empty() && baseline_dirs[p.scenario].empty()) continue;  // nothing to compare with
     const std::string summary_path = p.options.out_dir + "/summary.json";
     AblationBatch batch{p.effect, ReadJsonOrNull(summary_path), ReadJsonOrNull(p.options.out_dir + "/timing.json"), {}};
     if (!batch.summary.is_object()) throw InputError(summary_path, "missing or malformed after the batch ran");

@@ -9,7 +9,8 @@
 //   <scenario>/without_<effect>/comparison.{json,md}       per metric the verdict against all_effects
 //   twin_vs_robot.md, twin_vs_robot.json                   the table
 // A batch folder whose batch.json records the same scenario file, overrides, seed and trials and that
-// holds a summary.json is reused, so an interrupted ablation resumes where it stopped.
+// holds a summary.json is reused, so an interrupted ablation resumes where it stopped (and
+// `report_only` writes the table of what has finished so far).
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -43,6 +44,7 @@ struct AblationOptions {
   std::optional<std::uint64_t> seed;
   int jobs = DefaultJobs();
   BatchExecutor* executor = nullptr;  // where the batches run (null: here)
+  bool report_only = false;           // run nothing: the report of the batches finished so far
 };
 
 // Runs the batches and writes the reports; returns 0 (an ablation reports, it does not judge).
