@@ -376,6 +376,46 @@ TEST(TrajectoryPlot, DrawsMapTrajectoriesAndGoals) {
   EXPECT_TRUE(AnyNear(image, pixel(7.0, 0.5), 6, [](const cv::Vec3b& bgr) { return bgr[1] < 100; }));
 }
 
+// The localization log is read back frame by frame (a frame without truth has no position), and the
+// map puts each frame at its position in its outcome's colour: accepted green, no pose orange,
+// rejected red.
+TEST(LocalizationMapPlot, FramesAtTheirTruePositionsInTheirOutcomesColours) {
+  const std::string dir = testing::TempDir("batch_report");
+  const std::string csv = dir + "/localization.csv";
+  {
+    std::ofstream out(csv);
+    out << "t,true_x,true_y,true_yaw,outcome,failure,features,matches,inliers,error_m,sigma_m,nees\n"
+        << "0.2,1.0,1.0,0.0,accepted,\"\",900,300,200,0.01,0.02,0.3\n"
+        << "0.8,3.0,1.0,0.0,no pose: pose,\"RANSAC found 4 inliers, 12 needed\",900,90,0,,,\n"
+        << "1.4,5.0,1.0,0.0,rejected as an outlier,\"\",900,60,20,2.1,0.02,9000\n"
+        << "2.0,,,,pending,\"\",900,300,200,,,\n";
+  }
+  const std::vector<LocalizationFrame> frames = ReadLocalizationCsv(csv);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(frames[1].outcome, "no pose: pose");
+  EXPECT_EQ(frames[2].position, Eigen::Vector2d(5.0, 1.0));
+  EXPECT_FALSE(frames[3].position.allFinite());
+  const std::string path = dir + "/localization_map.png";
+  fs::remove(path);
+  const garden::OccupancyMap map = TestMap();
+  WriteLocalizationMap(path, map, map, frames, "lawn: where localization broke");
+  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);  // BGR
+  ASSERT_FALSE(image.empty()) << path;
+  int map_top = 0;
+  while (map_top < image.rows && image.at<cv::Vec3b>(map_top, image.cols - 1) == cv::Vec3b(255, 255, 255)) ++map_top;
+  const auto pixel = [&](double x, double y) {
+    return cv::Point(static_cast<int>(std::lround((x + 2.0) * 120.0)),
+                     map_top + static_cast<int>(std::lround((4.0 - y) * 120.0)));
+  };
+  const cv::Vec3b accepted = image.at<cv::Vec3b>(pixel(1.0, 1.0)), no_pose = image.at<cv::Vec3b>(pixel(3.0, 1.0)),
+                  rejected = image.at<cv::Vec3b>(pixel(5.0, 1.0));
+  EXPECT_TRUE(accepted[1] > accepted[0] + 60 && accepted[1] > accepted[2] + 60) << accepted;
+  EXPECT_TRUE(no_pose[2] > 200 && no_pose[1] > 100 && no_pose[0] < 80) << no_pose;
+  EXPECT_TRUE(rejected[2] > 150 && rejected[1] < 80) << rejected;
+  const std::string bad = testing::WriteTempFile("localization_bad.csv", "t,true_x\n0.2,1.0\n");
+  EXPECT_THROW(ReadLocalizationCsv(bad), InputError);
+}
+
 TrialResult TrialWithErrors(int index, double scale_m) {
   TrialResult trial;
   trial.index = index;

@@ -339,6 +339,61 @@ void DrawHistogramPanel(cv::Mat& image, cv::Rect panel, const std::string& name,
   PutText(image, "median", {key_x + 30, plot.y + 37}, 0.45, kInk);
 }
 
+// The robot's map (and what the garden has that it lacks) in an image about kPlotWidth wide, under
+// a title band, with `legend_height` pixels left below it.
+struct MapCanvas {
+  cv::Mat image;
+  MapToImage to_image;
+  int legend_top = 0;
+};
+MapCanvas DrawMapCanvas(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
+                        int legend_height, const std::string& title) {
+  const Eigen::Vector2d map_size = MapSize(map);
+  if (map.occupied.empty() || map_size.x() <= 0 || map_size.y() <= 0) {
+    throw std::invalid_argument(path + ": cannot plot over an empty map");
+  }
+  if (true_map.occupied.size() != map.occupied.size()) {
+    throw std::invalid_argument(path + ": the true_map's map must have the prior map's cells");
+  }
+  // About 1200 px wide; a very tall map is scaled to keep the image a sensible height instead.
+  MapCanvas canvas;
+  MapToImage& to_image = canvas.to_image;
+  to_image.origin = map.origin;
+  to_image.map_height_m = map_size.y();
+  to_image.pixels_per_metre = std::min(kPlotWidth / map_size.x(), 2.0 * kPlotWidth / map_size.y());
+  const cv::Size map_px(static_cast<int>(std::lround(map_size.x() * to_image.pixels_per_metre)),
+                        static_cast<int>(std::lround(map_size.y() * to_image.pixels_per_metre)));
+  to_image.offset = {static_cast<double>((kPlotWidth - map_px.width) / 2), static_cast<double>(kTitleBandHeight)};
+  canvas.legend_top = kTitleBandHeight + map_px.height;
+  canvas.image = cv::Mat(canvas.legend_top + legend_height, kPlotWidth, CV_8UC3, kWhite);
+  const cv::Rect map_area(cv::Point(static_cast<int>(to_image.offset.x), kTitleBandHeight), map_px);
+  RenderMap(map, true_map, map_px, to_image).copyTo(canvas.image(map_area));
+  cv::rectangle(canvas.image, map_area, cv::Scalar(150, 150, 150), 1);
+  PutText(canvas.image, title, {kLegendMargin, 32}, 0.8, kInk, 2);
+  return canvas;
+}
+
+// A frame's outcome (localization.csv) as one of the plot's classes, and the class's colour.
+struct OutcomeClass {
+  std::string label;
+  cv::Scalar colour;
+};
+const std::vector<OutcomeClass>& OutcomeClasses() {
+  static const std::vector<OutcomeClass> classes = {{"fix accepted", cv::Scalar(40, 160, 60)},
+                                                    {"no pose", cv::Scalar(240, 150, 20)},
+                                                    {"fix rejected by the EKF", cv::Scalar(200, 20, 20)},
+                                                    {"relocalized", cv::Scalar(120, 40, 200)},
+                                                    {"other (too old, pending)", cv::Scalar(130, 130, 130)}};
+  return classes;
+}
+std::size_t OutcomeClassOf(const std::string& outcome) {
+  if (outcome == "accepted") return 0;
+  if (outcome.rfind("no pose", 0) == 0) return 1;
+  if (outcome == "rejected as an outlier") return 2;
+  if (outcome == "relocalized") return 3;
+  return 4;
+}
+
 }  // namespace
 
 void WriteJunitXml(const std::string& path, const BatchSummary& summary) {
@@ -402,28 +457,10 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary) {
 void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
                          const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
                          const std::string& title) {
-  const Eigen::Vector2d map_size = MapSize(map);
-  if (map.occupied.empty() || map_size.x() <= 0 || map_size.y() <= 0) {
-    throw std::invalid_argument(path + ": cannot plot trajectories over an empty map");
-  }
-  // About 1200 px wide; a very tall map is scaled to keep the image a sensible height instead.
-  MapToImage to_image;
-  to_image.origin = map.origin;
-  to_image.map_height_m = map_size.y();
-  to_image.pixels_per_metre = std::min(kPlotWidth / map_size.x(), 2.0 * kPlotWidth / map_size.y());
-  const cv::Size map_px(static_cast<int>(std::lround(map_size.x() * to_image.pixels_per_metre)),
-                        static_cast<int>(std::lround(map_size.y() * to_image.pixels_per_metre)));
-  to_image.offset = {static_cast<double>((kPlotWidth - map_px.width) / 2), static_cast<double>(kTitleBandHeight)};
-
-  const int legend_top = kTitleBandHeight + map_px.height;
-  cv::Mat image(legend_top + LegendHeight(trajectories.size()), kPlotWidth, CV_8UC3, kWhite);
-  const cv::Rect map_area(cv::Point(static_cast<int>(to_image.offset.x), kTitleBandHeight), map_px);
-  if (true_map.occupied.size() != map.occupied.size()) {
-    throw std::invalid_argument(path + ": the true_map's map must have the prior map's cells");
-  }
-  RenderMap(map, true_map, map_px, to_image).copyTo(image(map_area));
-  cv::rectangle(image, map_area, cv::Scalar(150, 150, 150), 1);
-  PutText(image, title, {kLegendMargin, 32}, 0.8, kInk, 2);
+  MapCanvas canvas = DrawMapCanvas(path, map, true_map, LegendHeight(trajectories.size()), title);
+  cv::Mat& image = canvas.image;
+  const MapToImage& to_image = canvas.to_image;
+  const int legend_top = canvas.legend_top;
 
   std::vector<TrialColours> colours;
   int successes = 0, failures = 0;
@@ -479,6 +516,55 @@ void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult
     DrawHistogramPanel(image, panel, names[i], pooled_m[names[i]]);
   }
   WritePng(path, image, true);
+}
+
+void WriteLocalizationMap(const std::string& path, const garden::OccupancyMap& map,
+                          const garden::OccupancyMap& true_map, const std::vector<LocalizationFrame>& frames,
+                          const std::string& title) {
+  MapCanvas canvas = DrawMapCanvas(path, map, true_map, kLegendRowHeight + 2 * kLegendMargin, title);
+  std::vector<int> counts(OutcomeClasses().size(), 0);
+  // Accepted fixes first, so that the frames where localization broke are drawn over them.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const LocalizationFrame& frame : frames) {
+      const std::size_t k = OutcomeClassOf(frame.outcome);
+      if ((k == 0) != (pass == 0) || !frame.position.allFinite()) continue;
+      ++counts[k];
+      cv::circle(canvas.image, FixedPoint(canvas.to_image(frame.position)), (k == 0 ? 3 : 4) << kSubpixelBits,
+                 OutcomeClasses()[k].colour, cv::FILLED, cv::LINE_AA, kSubpixelBits);
+    }
+  }
+  int x = kLegendMargin;
+  const int y = canvas.legend_top + kLegendMargin + kLegendRowHeight / 2;
+  for (std::size_t k = 0; k < counts.size(); ++k) {
+    const std::string label = OutcomeClasses()[k].label + ": " + std::to_string(counts[k]);
+    cv::circle(canvas.image, {x + 6, y}, 5, OutcomeClasses()[k].colour, cv::FILLED, cv::LINE_AA);
+    PutText(canvas.image, label, {x + 18, y + 6}, 0.5, kInk);
+    x += 18 + TextSize(label, 0.5, 1).width + 28;
+  }
+  WritePng(path, canvas.image, true);
+}
+
+std::vector<LocalizationFrame> ReadLocalizationCsv(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw InputError(path, "cannot open the localization log");
+  std::vector<LocalizationFrame> frames;
+  std::string line;
+  std::getline(file, line);  // the header
+  for (int line_number = 2; std::getline(file, line); ++line_number) {
+    // t, true_x, true_y, true_yaw, outcome: the fields before the quoted failure text.
+    std::istringstream fields(line);
+    std::string t, x, y, yaw, outcome;
+    if (!std::getline(fields, t, ',') || !std::getline(fields, x, ',') || !std::getline(fields, y, ',') ||
+        !std::getline(fields, yaw, ',') || !std::getline(fields, outcome, ',')) {
+      throw InputError(path, "line " + std::to_string(line_number) + ": fewer than 5 fields");
+    }
+    const double nan = std::nan("");
+    frames.push_back({x.empty() || y.empty()
+                          ? Eigen::Vector2d(nan, nan)
+                          : Eigen::Vector2d(std::strtod(x.c_str(), nullptr), std::strtod(y.c_str(), nullptr)),
+                      outcome});
+  }
+  return frames;
 }
 
 std::vector<Eigen::Vector2d> ReadTumPositions(const std::string& path) {

@@ -1,7 +1,8 @@
 #pragma once
 // Report files of a batch: JUnit XML for CI (one test case per pass criterion, plus one per trial),
 // and PNG plots - trajectories over the robot's map (as Figures 13/14 of the reference deliverable)
-// and histograms of the localization errors (as Figure 12). All files are written atomically.
+// histograms of the localization errors (as Figure 12), and where the visual localization broke.
+// All files are written atomically.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -24,6 +25,18 @@ void WriteJunitXml(const std::string& path, const BatchSummary& summary);
 void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,
                          const std::vector<PlotTrajectory>& trajectories, const std::vector<Eigen::Vector2d>& goals,
                          const std::string& title);
+// One frame the stack's visual localization tried (localization.csv): its true position and outcome.
+struct LocalizationFrame {
+  Eigen::Vector2d position;  // map frame, metres (NaN when the truth was not known)
+  std::string outcome;
+};
+// Where localization breaks: every frame of the trials at its true position over the map, coloured
+// by outcome (fix accepted, no pose, fix rejected by the EKF, re-localization, other), with counts.
+void WriteLocalizationMap(const std::string& path, const garden::OccupancyMap& map,
+                          const garden::OccupancyMap& true_map, const std::vector<LocalizationFrame>& frames,
+                          const std::string& title);
+// The frames of a trial's localization.csv; throws InputError naming the file and line when malformed.
+std::vector<LocalizationFrame> ReadLocalizationCsv(const std::string& path);
 // One panel per estimate name found in the trials (position error in centimetres).
 void WriteErrorHistograms(const std::string& path, const std::vector<TrialResult>& trials, const std::string& title);
 // x, y of each line of a TUM trajectory file ("t x y z qx qy qz qw"; # comments skipped).

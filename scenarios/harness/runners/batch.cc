@@ -225,8 +225,13 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
     WriteArmReachPlot(out + "/arm_reach.png", scenario.name + ": cutter poses reached (ground truth)", results);
   } else {
     std::vector<PlotTrajectory> trajectories;
+    std::vector<LocalizationFrame> frames;
     for (const auto& r : results) {
       const std::string dir = TrialDir(out, r.index);
+      if (fs::exists(dir + "/localization.csv")) {
+        const auto trial_frames = ReadLocalizationCsv(dir + "/localization.csv");
+        frames.insert(frames.end(), trial_frames.begin(), trial_frames.end());
+      }
       if (!fs::exists(dir + "/ground_truth.tum") || !fs::exists(dir + "/ekf.tum")) continue;
       trajectories.push_back(
           {r.index, r.success, ReadTumPositions(dir + "/ground_truth.tum"), ReadTumPositions(dir + "/ekf.tum")});
@@ -234,6 +239,10 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
     WriteTrajectoryPlot(
         out + "/trajectories.png", map, true_map, trajectories, goals,
         scenario.name + ": ground truth (thick) and EKF (thin), " + std::to_string(results.size()) + " trials");
+    if (!frames.empty()) {
+      WriteLocalizationMap(out + "/localization_map.png", map, true_map, frames,
+                           scenario.name + ": where visual localization broke, every frame at its true position");
+    }
     WriteErrorHistograms(out + "/localization_errors.png", results,
                          scenario.name + ": localization error against ground truth");
     WriteBushFramePlot(out + "/bush_frames.png", scenario.name + ": the bush from stereo per frame", results);
