@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include "test_support.h"
 #include "trimbot/robot/camera_rig.h"
@@ -199,6 +200,69 @@ TEST(LogMapBuilder, ClosesTheLoopRecoversTheWheelScaleAndTiesTheMapToTheSurvey) 
   const VisualMap untied_map = untied.Build("synthetic", &untied_stats);
   EXPECT_TRUE(untied_map.keyframes[0].T_map_base.isApprox(believed_start, 1e-12));
   EXPECT_EQ(untied_stats.gaps, (std::vector<int>{5, 6}));
+}
+
+// A near surface that one keyframe's stereo pair saw and no other keyframe did is not a map point
+// (its depth rests on the 3 cm baseline and nothing checks it; a surface seen on every pass again
+// by each keyframe's stereo pairs would otherwise become many near-copies of one point), while a
+// surface the drive keeps in view is mapped, from several keyframes.
+TEST(LogMapBuilder, MapsOnlyPointsSeenFromTwoKeyframes) {
+  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
+  const int first = rig.StereoPairs().front().left;
+  const Eigen::Isometry3d T_base_camera = rig.camera(first).T_base_camera;
+  // The base backs away from a wall 1.2 m in front of the first pair's left camera, in 10 cm steps.
+  Eigen::Vector3d axis = T_base_camera.linear().col(2);
+  axis.z() = 0.0;
+  axis.normalize();
+  const Eigen::Vector3d side = Eigen::Vector3d::UnitZ().cross(axis);
+  const Eigen::Vector3d wall_centre = T_base_camera.translation() + 1.2 * axis;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-0.5, 0.5);
+  SyntheticGarden steady, once;  // the wall's points every keyframe sees, and those only the first does
+  for (SyntheticGarden* garden : {&steady, &once}) {
+    for (int i = 0; i < 200; ++i) {
+      garden->points.push_back(wall_centre + 0.6 * unit(rng) * side + Eigen::Vector3d(0.0, 0.0, 0.3 * unit(rng)));
+    }
+  }
+  cv::RNG cv_rng(4);
+  for (SyntheticGarden* garden : {&steady, &once}) {
+    garden->descriptors = cv::Mat(200, 128, CV_32F);
+    cv_rng.fill(garden->descriptors, cv::RNG::UNIFORM, 0.0, 100.0);
+  }
+  MapBuilderOptions options;
+  options.poses = KeyframePoses::kOdometry;
+  options.vocabulary_words = 16;
+  MapBuilder builder(rig, options);
+  for (int k = 0; k < 4; ++k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = -0.1 * k * axis;
+    std::vector<MappingImage> images = Observe(steady, rig, T, rng);
+    if (k == 0) {
+      const std::vector<MappingImage> extra = Observe(once, rig, T, rng);
+      for (std::size_t c = 0; c < images.size(); ++c) {
+        if (extra[c].pixels.empty()) continue;
+        images[c].pixels.insert(images[c].pixels.end(), extra[c].pixels.begin(), extra[c].pixels.end());
+        images[c].bearings.insert(images[c].bearings.end(), extra[c].bearings.begin(), extra[c].bearings.end());
+        if (images[c].descriptors.empty())
+          images[c].descriptors = extra[c].descriptors;
+        else
+          cv::vconcat(images[c].descriptors, extra[c].descriptors, images[c].descriptors);
+      }
+    }
+    builder.AddKeyframe(0.5 * k, std::move(images), T);
+  }
+  MapBuildStats stats;
+  const VisualMap map = builder.Build("synthetic", &stats);
+  std::printf("%d points, %d stereo matches, %d single-keyframe tracks dropped\n", stats.points, stats.stereo_matches,
+              stats.single_keyframe_tracks);
+  EXPECT_GT(stats.single_keyframe_tracks, 100) << "most of the surface seen once was matched by the stereo pair";
+  EXPECT_GT(stats.points, 100) << "the surface kept in view is mapped";
+  EXPECT_LE(stats.points, 200);
+  std::vector<std::set<int>> keyframes_seeing(map.points.size());
+  for (const auto& o : map.observations) keyframes_seeing[static_cast<std::size_t>(o.point)].insert(o.keyframe);
+  for (std::size_t i = 0; i < map.points.size(); ++i) {
+    ASSERT_GE(keyframes_seeing[i].size(), 2u) << "map point " << i << " seen from one keyframe only";
+  }
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "trimbot/common/random.h"
 #include "trimbot/common/yaml_reader.h"
 #include "trimbot/garden/textures.h"
+#include "trimbot/visual_localization/map_builder.h"
 #include "trimbot/visual_localization/visual_map.h"
 
 namespace trimbot::scenarios {
@@ -176,6 +177,7 @@ std::string MapCacheKey(const MapRecipe& recipe, const ProjectPaths& paths) {
   std::ostringstream key;
   key << "trimbot visual map cache key 1\n"
       << "map format version " << visual_localization::kMapFormatVersion << "\n"
+      << "map builder version " << visual_localization::kMapBuilderVersion << "\n"
       << "garden appearance version " << garden::kTextureGeneratorVersion << "\n"
       << "mapping drive " << Hex(Fnv1a(YamlContent(recipe.plan_path))) << "\n"
       << "garden " << Hex(Fnv1a(YamlContent(ResolveGarden(setting, paths)))) << "\n"

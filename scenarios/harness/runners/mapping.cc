@@ -267,6 +267,7 @@ nlohmann::json MapStats(const std::string& plan_path, std::uint64_t seed, const 
 // The log builder's own figures: stereo, loops, wheel scales, the tie to the surveyed garden.
 nlohmann::json LogBuildStats(const visual_localization::MapBuildStats& stats, std::size_t loops_found) {
   return {{"stereo_matches", stats.stereo_matches},
+          {"single_keyframe_tracks_dropped", stats.single_keyframe_tracks},
           {"loops_tried", stats.loops_tried},
           {"loops_found", loops_found},
           {"loops_accepted", stats.loops_accepted},

@@ -168,6 +168,20 @@ std::vector<Track> JoinTracks(const std::vector<MappingKeyframe>& keyframes, con
   return tracks;
 }
 
+// Whether a track holds observations from at least two keyframes. A track seen by one keyframe
+// only (the two cameras of a stereo pair) is not a map point: its depth rests on a 3 cm baseline
+// (at 1.5 m and 1 px, 10-15 cm along the ray), no second pose checks it, and it constrains no
+// keyframe pose in the adjustment. The next keyframe's stereo pair sees the same surface again as
+// another such track, so a surface passed twice or slowly became many near-copies of one point -
+// which defeat the localizer's ratio test (its best and second-best candidates are one surface).
+// Stereo observations still join tracks that span keyframes, and give the map its scale there.
+bool SpansKeyframes(const Track& track) {
+  for (const auto& r : track) {
+    if (r.keyframe != track.front().keyframe) return true;
+  }
+  return false;
+}
+
 // Midpoint triangulation from the keyframes' present poses; nullopt when the rays do not make a
 // good point (too parallel, behind or too far, or a ray further than `max_ray_angle` off it).
 std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& keyframes, const robot::CameraRig& rig,
@@ -204,7 +218,7 @@ std::optional<Eigen::Vector3d> Triangulate(const std::vector<MappingKeyframe>& k
 }
 
 // Drops observations with an error above `max_error` (px; `errors` as Adjust gives them), then
-// points seen fewer than twice. Returns how many observations were dropped.
+// points no longer seen from two keyframes. Returns how many observations were dropped.
 int RemoveOutliers(const std::vector<double>& errors, double max_error, std::vector<PointTrack>& points) {
   std::size_t next = 0;
   int dropped = 0;
@@ -215,7 +229,7 @@ int RemoveOutliers(const std::vector<double>& errors, double max_error, std::vec
       if (errors[next++] <= max_error) track.push_back(r);
     }
     dropped += static_cast<int>(p.track.size() - track.size());
-    if (track.size() >= 2) kept.push_back({p.position, std::move(track)});
+    if (SpansKeyframes(track)) kept.push_back({p.position, std::move(track)});
   }
   points = std::move(kept);
   return dropped;
@@ -236,9 +250,14 @@ std::vector<PointTrack> TriangulateTracks(const std::vector<MappingKeyframe>& ke
                                           double max_ray_angle, MapBuildStats* stats) {
   const std::vector<Track> tracks = JoinTracks(keyframes, matches);
   stats->tracks = static_cast<int>(tracks.size());
+  stats->single_keyframe_tracks = 0;
   stats->matches = static_cast<int>(matches.size());
   std::vector<PointTrack> points;
   for (const auto& track : tracks) {
+    if (!SpansKeyframes(track)) {
+      ++stats->single_keyframe_tracks;
+      continue;
+    }
     if (const auto X = Triangulate(keyframes, rig, track, options, max_ray_angle)) points.push_back({*X, track});
   }
   return points;

@@ -39,6 +39,10 @@
 
 namespace trimbot::visual_localization {
 
+// Raised whenever the builder makes a different map from the same drive and settings (a map cache
+// keys on it). 2: tracks seen by one keyframe only are no longer map points.
+constexpr int kMapBuilderVersion = 2;
+
 enum class KeyframePoses { kOdometry, kSurveyed };
 // "log" (odometry) or "surveyed": the map's builder. Inline: the scenario reader (fuzzed without
 // this library) parses it too.
@@ -132,6 +136,7 @@ struct MapBuilderOptions {
 struct MapBuildStats {
   int frames = 0, keyframes = 0, images_matched = 0, matches = 0, tracks = 0, points = 0, observations = 0;
   int stereo_matches = 0;                   // within a keyframe, between the two cameras of a pair
+  int single_keyframe_tracks = 0;           // seen by one keyframe's stereo pair only: not map points
   int outlier_observations = 0;             // dropped after the first adjustment
   int loops_tried = 0, loops_accepted = 0;  // verified loop candidates, edges kept
   // Keyframe steps (k-1 -> k, listed by k) that share fewer than `min_shared_points` map points:
