@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -147,10 +148,27 @@ scenarios::MapBuildOptions ShortLawnMap(const std::string& dir, KeyframePoses bu
   return options;
 }
 
+// The mean keyframe error (after a rigid alignment) a log-built map of a straight drive may have
+// from its scale alone: the scale is the stereo pairs' calibrated baselines', each known to
+// sqrt(2) x the calibration's camera translation error (the default's 1 sigma) over the baseline;
+// a scale error e over a straight drive of length L leaves e L / 4 on average. Three sigma of it.
+double ScaleErrorBound(const std::string& truth_tum) {
+  std::ifstream in(truth_tum);
+  std::vector<Eigen::Vector3d> positions;
+  double t = 0.0, x = 0.0, y = 0.0, z = 0.0, qx = 0.0, qy = 0.0, qz = 0.0, qw = 0.0;
+  while (in >> t >> x >> y >> z >> qx >> qy >> qz >> qw) positions.emplace_back(x, y, z);
+  if (positions.size() < 2) return 0.0;
+  const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
+  const double baseline = rig.StereoPairs().front().baseline;
+  const double scale_sigma = std::sqrt(2.0) * scenarios::CalibrationError{}.translation_m / baseline;
+  return 3.0 * scale_sigma * (positions.back() - positions.front()).norm() / 4.0;
+}
+
 // From the robot's own log (odometry, stereo, the tie to the surveyed garden): the keyframes'
-// shape within 1 cm of the truth (0.3 mm measured on 20 s), far better than the odometry it
-// started from, and the map's frame within 15 cm of the garden's (the tape survey's errors of the
-// few objects 12 s of driving sees; 6 cm measured on 20 s). The evaluation's files are written.
+// shape within what the calibration leaves of the scale (1.7 cm on this 2.4 m drive; 1.0 cm
+// measured), better than the odometry it started from, and the map's frame within 15 cm of the
+// garden's (the tape survey's errors of the few objects 12 s of driving sees). The evaluation's
+// files are written.
 TEST(MapBuild, ALogBuiltMapOfAShortDriveIsWithinItsStatedErrors) {
   const scenarios::MapBuildOptions options =
       ShortLawnMap(testing::TempDir("map_build_log"), KeyframePoses::kOdometry, 12.0);
@@ -168,7 +186,8 @@ TEST(MapBuild, ALogBuiltMapOfAShortDriveIsWithinItsStatedErrors) {
       built["ate_se3_aligned_m"]["mean"].get<double>(), odometry["ate_se3_aligned_m"]["mean"].get<double>(),
       built["ate_unaligned_m"]["mean"].get<double>(), built["rpe_per_keyframe_m"]["mean"].get<double>(),
       stats["evaluation"]["points_to_true_surfaces_m"]["median"].get<double>());
-  EXPECT_LT(built["ate_se3_aligned_m"]["mean"].get<double>(), 0.01);
+  EXPECT_LT(built["ate_se3_aligned_m"]["mean"].get<double>(),
+            ScaleErrorBound(options.out_dir + "/keyframes_truth.tum"));
   EXPECT_LT(built["ate_se3_aligned_m"]["mean"].get<double>(), odometry["ate_se3_aligned_m"]["mean"].get<double>());
   EXPECT_LT(built["ate_unaligned_m"]["mean"].get<double>(), 0.15);
   EXPECT_LT(stats["evaluation"]["points_to_true_surfaces_m"]["median"].get<double>(), 0.05);

@@ -22,8 +22,8 @@ struct CalibrationError {
   std::uint64_t seed = 0;
   double focal_relative = 2e-4;            // fx, fy scaled by (1 + e): 0.1 px of ~550 px
   double principal_point_px = 0.2;         // cx, cy
-  double rotation_deg = 0.05;              // of each camera relative to cam0 (cam0's pose is the URDF's)
-  double translation_m = 0.001;            // of each camera relative to cam0
+  double rotation_deg = 0.01;              // of each camera relative to cam0 (cam0's pose is the URDF's)
+  double translation_m = 2e-4;             // of each camera relative to cam0
   double camera_imu_time_offset_s = 5e-4;  // the images' stamps against the IMU's
   bool any() const {
     return focal_relative > 0 || principal_point_px > 0 || rotation_deg > 0 || translation_m > 0 ||
