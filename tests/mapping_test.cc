@@ -15,6 +15,7 @@
 #include "loop/pilots.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
+#include "reports/batch_report.h"
 #include "runners/localization_eval.h"
 #include "runners/map_cache.h"
 #include "runners/mapping.h"
@@ -153,10 +154,7 @@ scenarios::MapBuildOptions ShortLawnMap(const std::string& dir, KeyframePoses bu
 // sqrt(2) x the calibration's camera translation error (the default's 1 sigma) over the baseline;
 // a scale error e over a straight drive of length L leaves e L / 4 on average. Three sigma of it.
 double ScaleErrorBound(const std::string& truth_tum) {
-  std::ifstream in(truth_tum);
-  std::vector<Eigen::Vector3d> positions;
-  double t = 0.0, x = 0.0, y = 0.0, z = 0.0, qx = 0.0, qy = 0.0, qz = 0.0, qw = 0.0;
-  while (in >> t >> x >> y >> z >> qx >> qy >> qz >> qw) positions.emplace_back(x, y, z);
+  const std::vector<Eigen::Vector2d> positions = scenarios::ReadTumPositions(truth_tum);
   if (positions.size() < 2) return 0.0;
   const robot::CameraRig rig = robot::LoadCameraRig(robot::RobotFiles::InFolder(testing::SourcePath("robot")));
   const double baseline = rig.StereoPairs().front().baseline;
