@@ -1,6 +1,7 @@
 #include "trimbot/stack/ekf.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -15,7 +16,7 @@ using StateMatrix = Ekf::StateMatrix;
 constexpr int kN = Ekf::kStateSize;
 
 // State layout.
-constexpr int kX = 0, kY = 1, kYaw = 2, kV = 3, kW = 4, kBias = 5, kScale = 6;
+constexpr int kX = 0, kY = 1, kYaw = 2, kV = 3, kW = 4, kBias = 5, kScale = 6, kSharedX = 7, kSharedY = 8;
 
 // Prior on the states Initialize() is not told about. The first wheel speeds settle v and w at
 // once; the bias prior is a MEMS gyro's turn-on bias (about 1 deg/s).
@@ -113,19 +114,54 @@ void Propagate(const StateVector& x, const StateMatrix& P, double dt, const EkfP
   }
   StateMatrix F;
   PropagateMotion(x, dt, x_out, &F);
-  const StateMatrix predicted = F * P * F.transpose() + ProcessNoise(x, dt, parameters);
+  StateMatrix Q = ProcessNoise(x, dt, parameters);
+  // The shared fix error decorrelates with the ground travelled: Gauss-Markov over distance, its
+  // stationary variance kept by the noise that replaces what decays.
+  const double sigma = parameters.shared_fix_error_sigma;
+  if (sigma > 0.0) {
+    const double travelled = std::abs(x(kV) / (1.0 + x(kScale))) * dt;
+    const double keep = std::exp(-travelled / std::max(parameters.shared_fix_error_distance, 1e-3));
+    for (int k : {kSharedX, kSharedY}) {
+      (*x_out)(k) = keep * x(k);
+      F(k, k) = keep;
+      Q(k, k) = (1.0 - keep * keep) * sigma * sigma;
+    }
+  }
+  const StateMatrix predicted = F * P * F.transpose() + Q;
   *P_out = 0.5 * (predicted + predicted.transpose());
 }
 
-// Measurement model of a pose fix: z = (x, y, yaw), the yaw innovation wrapped.
+// Measurement model of a pose fix: z = (x + shared_x, y + shared_y, yaw), the yaw innovation wrapped.
 Eigen::Vector3d PoseInnovation(const messages::PoseFix& fix, const StateVector& x) {
-  return {fix.x - x(kX), fix.y - x(kY), WrapAngle(fix.yaw - x(kYaw))};
+  return {fix.x - x(kX) - x(kSharedX), fix.y - x(kY) - x(kSharedY), WrapAngle(fix.yaw - x(kYaw))};
 }
 
 Eigen::Matrix<double, 3, kN> PoseJacobian() {
   Eigen::Matrix<double, 3, kN> H = Eigen::Matrix<double, 3, kN>::Zero();
   H.leftCols<3>().setIdentity();
+  H(0, kSharedX) = 1.0;
+  H(1, kSharedY) = 1.0;
   return H;
+}
+
+// The shared part of a fix's position variance: the source's stated sigma, but never more than
+// half of the fix's smallest position variance, so that its independent rest stays positive
+// definite whatever the fix states.
+double SharedFixVariance(const messages::PoseFix& fix, double shared_sigma) {
+  const double smallest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(fix.covariance.topLeftCorner<2, 2>(), Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .minCoeff();
+  return std::min(shared_sigma * shared_sigma, 0.5 * smallest);
+}
+
+// What of the fix's covariance is its own (independent of the other fixes).
+Eigen::Matrix3d IndependentFixCovariance(const messages::PoseFix& fix, double shared_sigma) {
+  Eigen::Matrix3d R = fix.covariance;
+  const double shared = SharedFixVariance(fix, shared_sigma);
+  R(0, 0) -= shared;
+  R(1, 1) -= shared;
+  return R;
 }
 
 // Linear Kalman update in Joseph form (keeps P symmetric positive semi-definite under rounding).
@@ -162,13 +198,16 @@ void Ekf::Initialize(double stamp, const Pose2& pose, const Eigen::Matrix3d& pos
     return;
   }
   stamp_ = stamp;
-  x_ << pose.x, pose.y, WrapAngle(pose.yaw), 0.0, 0.0, 0.0, 0.0;
+  x_.setZero();
+  x_.head<3>() << pose.x, pose.y, WrapAngle(pose.yaw);
   P_.setZero();
   P_.topLeftCorner<3, 3>() = pose_covariance;
   P_(kV, kV) = kInitialSpeedSigma * kInitialSpeedSigma;
   P_(kW, kW) = kInitialTurnRateSigma * kInitialTurnRateSigma;
   P_(kBias, kBias) = kInitialGyroBiasSigma * kInitialGyroBiasSigma;
   P_(kScale, kScale) = parameters_.wheel_scale_sigma * parameters_.wheel_scale_sigma;
+  P_(kSharedX, kSharedX) = P_(kSharedY, kSharedY) =
+      parameters_.shared_fix_error_sigma * parameters_.shared_fix_error_sigma;
   last_ticks_.reset();
   last_imu_stamp_.reset();
   history_.clear();
@@ -236,7 +275,8 @@ FixOutcome Ekf::AddPoseFix(const messages::PoseFix& fix) {
   StateMatrix P;
   StateAt(fix.stamp, &x, &P);
   const Eigen::Vector3d innovation = PoseInnovation(fix, x);
-  const Eigen::Matrix3d S = P.topLeftCorner<3, 3>() + fix.covariance;
+  const Eigen::Matrix<double, 3, kN> H = PoseJacobian();
+  const Eigen::Matrix3d S = H * P * H.transpose() + IndependentFixCovariance(fix, parameters_.shared_fix_error_sigma);
   const double mahalanobis2 = innovation.dot(S.llt().solve(innovation));
   if (mahalanobis2 <= parameters_.fix_gate_chi2) {
     Insert(fix.stamp, FixMeasurement{fix, false});
@@ -373,18 +413,24 @@ bool Ekf::UpdateGyro(double rate) {
 }
 
 bool Ekf::UpdatePose(const messages::PoseFix& fix) {
-  return KalmanUpdate<3>(PoseInnovation(fix, x_), PoseJacobian(), fix.covariance, &x_, &P_);
+  return KalmanUpdate<3>(PoseInnovation(fix, x_), PoseJacobian(),
+                         IndependentFixCovariance(fix, parameters_.shared_fix_error_sigma), &x_, &P_);
 }
 
 void Ekf::ResetPose(const messages::PoseFix& fix) {
   // Re-localization: the old pose and its correlations are wrong, so take the fix's pose and
-  // covariance as they are; the speeds and the gyro bias stay.
+  // covariance as they are, and start the shared fix error afresh; the speeds, the gyro bias and
+  // the slip stay.
   x_(kX) = fix.x;
   x_(kY) = fix.y;
   x_(kYaw) = WrapAngle(fix.yaw);
-  P_.topRows<3>().setZero();
-  P_.leftCols<3>().setZero();
+  x_(kSharedX) = x_(kSharedY) = 0.0;
+  for (int k : {kX, kY, kYaw, kSharedX, kSharedY}) {
+    P_.row(k).setZero();
+    P_.col(k).setZero();
+  }
   P_.topLeftCorner<3, 3>() = 0.5 * (fix.covariance + fix.covariance.transpose());
+  P_(kSharedX, kSharedX) = P_(kSharedY, kSharedY) = SharedFixVariance(fix, parameters_.shared_fix_error_sigma);
 }
 
 void Ekf::TrimHistory() {
