@@ -385,6 +385,10 @@ TEST(Batch, ShardsMergeIntoTheWholeBatchAndTrialsReplayBySeed) {
     EXPECT_EQ(RunBatch(options), 0);
   }
   ASSERT_EQ(MergeShards({root + "/shard0", root + "/shard1"}, root + "/merged"), 0);
+  // Each batch records the build that ran it (trimbot ablate reuses only batches of its own build).
+  const std::string build = ReadJson(root + "/shard0/batch.json").value("build", "");
+  EXPECT_EQ(build.size(), 16u);
+  EXPECT_EQ(build, BuildFingerprint());
   const json summary = ReadJson(root + "/merged/summary.json");
   ASSERT_EQ(summary["trials"].size(), 2u);
   for (int i = 0; i < 2; ++i) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "loop/prior_knowledge.h"
+#include "runners/batch.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 
@@ -42,7 +43,8 @@ std::vector<FidelityEffect> ChosenEffects(const std::vector<std::string>& names)
   return chosen;
 }
 
-// True when `dir` holds a finished batch of exactly this scenario file, overrides, seed and trials.
+// True when `dir` holds a finished batch of exactly this scenario file, overrides, seed and trials,
+// run by this very build.
 bool FinishedBatch(const BatchOptions& batch, const Scenario& scenario) {
   const json info = ReadJsonOrNull(batch.out_dir + "/batch.json");
   if (!info.is_object() || !fs::exists(batch.out_dir + "/summary.json")) return false;
@@ -51,7 +53,7 @@ bool FinishedBatch(const BatchOptions& batch, const Scenario& scenario) {
              fs::weakly_canonical(batch.scenario_path, error) &&
          info.value("overrides", std::vector<std::string>{}) == batch.overrides &&
          info.value("seed", std::uint64_t{0}) == scenario.setting.seed && info.value("trials", 0) == scenario.trials &&
-         info.value("shard", "") == "0/1";
+         info.value("shard", "") == "0/1" && info.value("build", "") == BuildFingerprint();
 }
 
 struct PlannedBatch {

@@ -32,6 +32,7 @@
 #include "runners/trial.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/random.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -47,6 +48,7 @@ struct BatchInfo {
   int trials = 0;
   int shard_index = 0, shard_count = 1;
   std::vector<std::string> overrides;  // --set, as given
+  std::string build;                   // BuildFingerprint() of the executable that ran it
 };
 
 json ToJson(const BatchInfo& info) {
@@ -54,7 +56,8 @@ json ToJson(const BatchInfo& info) {
           {"seed", info.seed},
           {"trials", info.trials},
           {"overrides", info.overrides},
-          {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)}};
+          {"shard", std::to_string(info.shard_index) + "/" + std::to_string(info.shard_count)},
+          {"build", info.build}};
 }
 
 std::string ReadText(const std::string& path) {
@@ -77,12 +80,29 @@ BatchInfo ReadBatchInfo(const std::string& dir) {
     info.trials = j.at("trials").get<int>();
     if (info.trials < 1 || info.trials > 100000) throw InputError(path, "'trials' must be in [1, 100000]");
     if (j.contains("overrides")) info.overrides = j.at("overrides").get<std::vector<std::string>>();
+    if (j.contains("build")) info.build = j.at("build").get<std::string>();
     std::tie(info.shard_index, info.shard_count) = ParseShard(j.at("shard").get<std::string>(), path);
     return info;
   } catch (const json::exception& e) {
     throw InputError(path, std::string("malformed: ") + e.what());
   }
 }
+
+}  // namespace
+
+std::string BuildFingerprint() {
+  static const std::string fingerprint = [] {
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    std::ostringstream hex;
+    hex << std::hex << std::setw(16) << std::setfill('0') << Fnv1a(bytes.str());
+    return hex.str();
+  }();
+  return fingerprint;
+}
+
+namespace {
 
 std::string TrialDir(const std::string& out, int index) {
   std::ostringstream name;
@@ -415,6 +435,7 @@ int RunBatch(const BatchOptions& options) {
   info.shard_index = options.shard_index;
   info.shard_count = options.shard_count;
   info.overrides = scenario.overrides;
+  info.build = BuildFingerprint();
   if (info.trials < 1) throw InputError(options.scenario_path, "--trials must be at least 1");
   if (options.jobs < 1) throw InputError(options.scenario_path, "--jobs must be at least 1");
   // A map the scenario builds from a mapping drive: from the cache, built there on first use.

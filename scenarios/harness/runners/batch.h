@@ -47,6 +47,10 @@ struct BatchOptions {
 // pass criterion holds, 1 when one fails. Bad input throws InputError.
 int RunBatch(const BatchOptions& options);
 
+// A fingerprint of the running trimbot executable (FNV-1a of its bytes, as hex): every batch.json
+// records it, and `trimbot ablate` reuses only batches of the same build.
+std::string BuildFingerprint();
+
 // Merges the output folders of shards of one batch into `out_dir` and writes the reports of the
 // whole batch. Returns the exit code as RunBatch.
 int MergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir,
