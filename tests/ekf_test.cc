@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
 #include "trimbot/stack/ekf.h"
 
@@ -268,6 +269,13 @@ TEST(Ekf, ASharedFixErrorAsAStateKeepsTheFilterConsistent) {
   EXPECT_GT(with_state, 1.0);
   EXPECT_LT(with_state, 5.0);
   EXPECT_GT(without_state, 3.0 * with_state);
+  // The source's shared error is set before the first input, never after (it would rewrite the past).
+  Ekf ekf = MakeEkf();
+  ekf.SetSharedFixError(0.02, 10.0);
+  EXPECT_NEAR(std::sqrt(ekf.covariance()(7, 7)), 0.02, 1e-12);
+  SimulatedBase base = ArcDrive(5);
+  StepSensors(&base, 0, &ekf);
+  EXPECT_THROW(ekf.SetSharedFixError(0.02, 10.0), std::logic_error);
 }
 
 TEST(Ekf, GyroBiasConvergesWithLateFixes) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <iterator>
+#include <stdexcept>
 #include <vector>
 
 namespace trimbot::stack {
@@ -213,6 +214,20 @@ void Ekf::Initialize(double stamp, const Pose2& pose, const Eigen::Matrix3d& pos
   history_.clear();
   rejected_run_.clear();
   initialized_ = true;
+}
+
+void Ekf::SetSharedFixError(double sigma, double distance) {
+  if (!history_.empty() || last_ticks_ || last_imu_stamp_) {
+    throw std::logic_error("Ekf::SetSharedFixError: after the first input");
+  }
+  parameters_.shared_fix_error_sigma = std::max(sigma, 0.0);
+  parameters_.shared_fix_error_distance = distance;
+  x_(kSharedX) = x_(kSharedY) = 0.0;
+  for (int k : {kSharedX, kSharedY}) {
+    P_.row(k).setZero();
+    P_.col(k).setZero();
+    P_(k, k) = parameters_.shared_fix_error_sigma * parameters_.shared_fix_error_sigma;
+  }
 }
 
 void Ekf::AddWheelTicks(const messages::WheelTicks& ticks) {

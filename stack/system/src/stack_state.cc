@@ -1,23 +1,15 @@
 #include "stack_state.h"
 
 #include "trimbot/robot/robot_parameters.h"
-#include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::stack {
 namespace {
 
-// The EKF's model of its fix source. The visual localizer's fixes share the map's error with the
-// fixes taken near them: its covariance floor stands for that error (the Gauss-Newton part is the
-// fix's own), and fixes share map points while their retrieval discs (prior_radius) overlap. The
-// test fixture's fixes and no fixes at all share nothing.
+// The EKF starts with fixes that share nothing (the test fixture's; or none); the visual
+// localizer's shared error is set when its map is loaded (RobotStack::SetVisualMap).
 EkfParameters EkfForSource(const StackParameters& parameters) {
   EkfParameters ekf = parameters.ekf;
-  if (parameters.localization == LocalizationSource::kVisual) {
-    ekf.shared_fix_error_sigma = visual_localization::LocalizerOptions{}.min_position_sigma;
-    ekf.shared_fix_error_distance = parameters.visual.prior_radius;
-  } else {
-    ekf.shared_fix_error_sigma = 0.0;
-  }
+  ekf.shared_fix_error_sigma = 0.0;
   return ekf;
 }
 

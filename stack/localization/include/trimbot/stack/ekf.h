@@ -55,8 +55,8 @@ struct EkfParameters {
   double gyro_sigma = 0.005;               // rad/s, one gyro sample
   // Pose fixes.
   // Of each fix's position sigma, the part the fix source shares with its other fixes within about
-  // shared_fix_error_distance of travel (0: fixes independent). Set by the stack from the source:
-  // the visual localizer's covariance floor over its retrieval radius.
+  // shared_fix_error_distance of travel (0: fixes independent). Set by the stack from the source
+  // (SetSharedFixError): the visual localizer's covariance floor over its map's extent.
   double shared_fix_error_sigma = 0.0;     // m per axis
   double shared_fix_error_distance = 3.0;  // m
   double fix_gate_chi2 = 11.34;            // 3 dof, 99 %: beyond this a fix is an outlier
@@ -93,6 +93,11 @@ class Ekf {
   using StateMatrix = Eigen::Matrix<double, kStateSize, kStateSize>;
 
   Ekf(const EkfParameters& parameters, const robot::DiffDriveGeometry& geometry, int ticks_per_revolution);
+
+  // The fix source's shared error (EkfParameters::shared_fix_error_*), known once the source is
+  // (a visual map's, when it is loaded): the shared state restarts at 0 with its stationary
+  // variance. Before the first sensor input only (std::logic_error after).
+  void SetSharedFixError(double sigma, double distance);
 
   // Starts the filter at a known pose (the robot's start pose, or the first fix).
   void Initialize(double stamp, const Pose2& pose, const Eigen::Matrix3d& pose_covariance);
