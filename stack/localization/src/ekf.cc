@@ -222,11 +222,15 @@ void Ekf::SetSharedFixError(double sigma, double distance) {
   }
   parameters_.shared_fix_error_sigma = std::max(sigma, 0.0);
   parameters_.shared_fix_error_distance = distance;
+  RestartSharedFixError(parameters_.shared_fix_error_sigma * parameters_.shared_fix_error_sigma);
+}
+
+void Ekf::RestartSharedFixError(double variance) {
   x_(kSharedX) = x_(kSharedY) = 0.0;
   for (int k : {kSharedX, kSharedY}) {
     P_.row(k).setZero();
     P_.col(k).setZero();
-    P_(k, k) = parameters_.shared_fix_error_sigma * parameters_.shared_fix_error_sigma;
+    P_(k, k) = variance;
   }
 }
 
@@ -439,13 +443,10 @@ void Ekf::ResetPose(const messages::PoseFix& fix) {
   x_(kX) = fix.x;
   x_(kY) = fix.y;
   x_(kYaw) = WrapAngle(fix.yaw);
-  x_(kSharedX) = x_(kSharedY) = 0.0;
-  for (int k : {kX, kY, kYaw, kSharedX, kSharedY}) {
-    P_.row(k).setZero();
-    P_.col(k).setZero();
-  }
+  P_.topRows<3>().setZero();
+  P_.leftCols<3>().setZero();
   P_.topLeftCorner<3, 3>() = 0.5 * (fix.covariance + fix.covariance.transpose());
-  P_(kSharedX, kSharedX) = P_(kSharedY, kSharedY) = SharedFixVariance(fix, parameters_.shared_fix_error_sigma);
+  RestartSharedFixError(SharedFixVariance(fix, parameters_.shared_fix_error_sigma));
 }
 
 void Ekf::TrimHistory() {

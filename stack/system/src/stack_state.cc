@@ -3,17 +3,6 @@
 #include "trimbot/robot/robot_parameters.h"
 
 namespace trimbot::stack {
-namespace {
-
-// The EKF starts with fixes that share nothing (the test fixture's; or none); the visual
-// localizer's shared error is set when its map is loaded (RobotStack::SetVisualMap).
-EkfParameters EkfForSource(const StackParameters& parameters) {
-  EkfParameters ekf = parameters.ekf;
-  ekf.shared_fix_error_sigma = 0.0;
-  return ekf;
-}
-
-}  // namespace
 
 StackState::StackState(const robot::RobotFiles& files, const StackParameters& parameters)
     : description(robot::RobotDescription::Load(files.urdf)),
@@ -21,7 +10,7 @@ StackState::StackState(const robot::RobotFiles& files, const StackParameters& pa
       ticks_per_revolution(robot::RobotParameters::Load(files.robot_parameters).wheel_encoders.ticks_per_revolution),
       odometry(description.drive(), ticks_per_revolution),
       servo_odometry(description.drive(), ticks_per_revolution),
-      ekf(EkfForSource(parameters), description.drive(), ticks_per_revolution),
+      ekf(parameters.ekf, description.drive(), ticks_per_revolution),
       arm_axis(description.FramePose(robot::RobotFrames::kCameraRing).translation().head<2>()),
       arm(description, parameters.arm),
       mission(parameters, arm_axis, ekf, servo_odometry, &arm) {}

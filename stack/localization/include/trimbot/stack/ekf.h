@@ -150,6 +150,8 @@ class Ekf {
   bool UpdateGyro(double rate);
   bool UpdatePose(const messages::PoseFix& fix);
   void ResetPose(const messages::PoseFix& fix);
+  // The shared fix error back to 0 with `variance` per axis, uncorrelated with the rest.
+  void RestartSharedFixError(double variance);
   void TrimHistory();
 
   EkfParameters parameters_;
