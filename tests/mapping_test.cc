@@ -325,6 +325,13 @@ TEST(LocalizationEval, BenchAndRetrievalOnAQueryDriveBesideTheMappedOne) {
   EXPECT_EQ(static_cast<int>(bench["time"]["frames_ms"].size()), frames);
   EXPECT_GT(bench["time"]["total"]["median_ms"].get<double>(), 0.0);
   EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/localization_time.png"));
+  // Beside the mapped drive the fixes are what they state (a NEES of 3 on average when they are).
+  EXPECT_GT(bench["nees"]["within_95_rate"].get<double>(), 0.8);
+  std::ifstream frames_file(options.out_dir + "/localization_frames.csv");
+  std::string line;
+  int rows = -1;  // the header
+  while (std::getline(frames_file, line)) ++rows;
+  EXPECT_EQ(rows, frames);
 
   options.out_dir = dir + "/retrieval";
   ASSERT_EQ(scenarios::RunRetrievalEval(options), 0);

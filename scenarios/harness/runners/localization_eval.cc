@@ -1,15 +1,19 @@
 #include "runners/localization_eval.h"
 
+#include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <random>
+#include <sstream>
 
 #include "evaluation/pose_errors.h"
 #include "evaluation/trial_result.h"
@@ -149,25 +153,43 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
   const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
   NoisyPrior prior(drive.setting.seed, options.prior_sigma);
   std::vector<visual_localization::LocalizationTimings> timings;
-  std::vector<double> position_errors, heading_errors;
+  std::vector<double> position_errors, heading_errors, nees;
   int fixes = 0, within_25cm = 0;
   std::vector<double> features, matches, inliers;
   std::map<std::string, int> failures;
+  // Per frame: where it was, what came of it, and the fix's error against the stated covariance.
+  std::ostringstream csv;
+  csv << "t,true_x,true_y,true_yaw,fix,failure,features,matches,inliers,error_m,sigma_m,nees\n";
   for (const QueryFrame& query : drive.frames) {
     const auto result = localizer->Localize(query.frame, prior(query.T_map_base));
     timings.push_back(result.timings);
     features.push_back(result.features);
     matches.push_back(result.matches);
     inliers.push_back(result.inliers);
-    if (!result.success) ++failures[result.failure];
-    if (!result.success) continue;
+    const Pose2 truth = ToPose2(query.T_map_base);
+    csv << std::fixed << std::setprecision(3) << query.frame.stamp << ',' << truth.x << ',' << truth.y << ','
+        << std::setprecision(4) << truth.yaw << ',' << (result.success ? 1 : 0) << ",\"" << result.failure << "\","
+        << result.features << ',' << result.matches << ',' << result.inliers << ',';
+    if (!result.success) {
+      ++failures[result.failure];
+      csv << ",,\n";
+      continue;
+    }
     ++fixes;
-    const double error = (result.T_map_base.translation() - query.T_map_base.translation()).head<2>().norm();
+    const Pose2 fix = ToPose2(result.T_map_base);
+    const Eigen::Vector3d error3(fix.x - truth.x, fix.y - truth.y, AngleDifference(fix.yaw, truth.yaw));
+    const double error = error3.head<2>().norm();
     position_errors.push_back(error);
-    heading_errors.push_back(std::abs(AngleDifference(ToPose2(result.T_map_base).yaw, ToPose2(query.T_map_base).yaw)) *
-                             180.0 / M_PI);
+    heading_errors.push_back(std::abs(error3.z()) * 180.0 / M_PI);
     within_25cm += error <= 0.25 ? 1 : 0;
+    // Is the stated covariance what the error is? (3 on average when it is, as the trials' fixes.)
+    nees.push_back(error3.dot(result.planar_covariance.ldlt().solve(error3)));
+    const double sigma =
+        std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(result.planar_covariance.topLeftCorner<2, 2>())
+                      .eigenvalues()(1));
+    csv << std::setprecision(4) << error << ',' << sigma << ',' << std::setprecision(3) << nees.back() << '\n';
   }
+  const auto nees_within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
   const double n = std::max<double>(1, drive.frames.size());
   const ErrorStats position = ErrorStats::From(position_errors), heading = ErrorStats::From(heading_errors);
   nlohmann::json report = DriveJson(options, query, drive);
@@ -178,10 +200,14 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
   report["per_frame_median"] = {{"features", ErrorStats::From(features).median},
                                 {"matches", ErrorStats::From(matches).median},
                                 {"inliers", ErrorStats::From(inliers).median}};
+  report["nees"] = {{"mean", ErrorStats::From(nees).mean},
+                    {"median", ErrorStats::From(nees).median},
+                    {"within_95_rate", nees.empty() ? 0.0 : static_cast<double>(nees_within) / nees.size()}};
   report["failures"] = failures;
   report["time"] = LocalizationTimeStats(timings);
   report["threads"] = cv::getNumThreads();
   WriteFileAtomically(options.out_dir + "/localization_bench.json", report.dump(2));
+  WriteFileAtomically(options.out_dir + "/localization_frames.csv", csv.str());
   WriteLocalizationTimeHistogram(options.out_dir + "/localization_time.png",
                                  "visual localization time per ring frame (" + std::to_string(drive.frames.size()) +
                                      " frames, " + std::to_string(cv::getNumThreads()) + " threads)",
@@ -192,6 +218,9 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
       "heading %.2f deg\n",
       drive.frames.size(), 100 * fixes / n, 100 * within_25cm / n, 100 * position.mean, 100 * position.median,
       heading.mean);
+  std::printf("[bench] fix consistency: NEES mean %.2f, median %.2f, %.1f %% within the 95 %% bound (3 dof)\n",
+              report["nees"]["mean"].get<double>(), report["nees"]["median"].get<double>(),
+              100 * report["nees"]["within_95_rate"].get<double>());
   std::printf("[bench] per frame (median): %.0f features, %.0f matches, %.0f inliers\n",
               ErrorStats::From(features).median, ErrorStats::From(matches).median, ErrorStats::From(inliers).median);
   std::printf(

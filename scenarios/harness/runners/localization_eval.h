@@ -3,7 +3,8 @@
 // drive (a drive plan, possibly at other conditions, another seed, shifted sideways): the
 // stack's own localizer (robot/config/stack.yaml's visual_localization, with --set overrides),
 // compared with the simulator's ground truth.
-//   trimbot map bench           per frame: fix or not, errors, time by stage (median, p90); the
+//   trimbot map bench           per frame: fix or not, errors, the fix NEES against its stated
+//                               covariance (localization_frames.csv), time by stage (median, p90); the
 //                               processing-time histogram (D3.4 Figure 10)
 //   trimbot map retrieval-eval  D3.4 Table 4: the share of the top-5 (--top) retrieved keyframes with at
 //                               least 50 / 100 / 200 geometrically verified matches, per image and
@@ -40,7 +41,7 @@ struct LocalizationEvalOptions {
   ProjectPaths paths;
 };
 
-// Writes localization_bench.json and localization_time.png into out_dir; returns the exit code.
+// Writes localization_bench.json, localization_frames.csv and localization_time.png into out_dir; returns the exit code.
 int RunLocalizationBench(const LocalizationEvalOptions& options);
 // Writes retrieval_eval.json into out_dir and prints the table; returns the exit code.
 int RunRetrievalEval(const LocalizationEvalOptions& options);
