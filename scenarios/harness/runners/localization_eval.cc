@@ -144,24 +144,19 @@ nlohmann::json DriveJson(const LocalizationEvalOptions& options, const QueryDriv
           {"frames", drive.frames.size()}};
 }
 
-}  // namespace
-
-int RunLocalizationBench(const LocalizationEvalOptions& options) {
-  std::filesystem::create_directories(options.out_dir);
-  QueryDriveOptions query;
-  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
-  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
-  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
+// The bench's figures, frame by frame: where it was, what came of it, and a fix's error against
+// the truth and against the covariance it stated (its NEES: 3 on average when it is what it says,
+// as the trials' fixes).
+struct BenchTally {
   std::vector<visual_localization::LocalizationTimings> timings;
   std::vector<double> position_errors, heading_errors, nees;
   int fixes = 0, within_25cm = 0;
   std::vector<double> features, matches, inliers;
   std::map<std::string, int> failures;
-  // Per frame: where it was, what came of it, and the fix's error against the stated covariance.
-  std::ostringstream csv;
-  csv << "t,true_x,true_y,true_yaw,fix,failure,features,matches,inliers,error_m,sigma_m,nees\n";
-  for (const QueryFrame& query : drive.frames) {
-    const auto result = localizer->Localize(query.frame, prior(query.T_map_base));
+  std::ostringstream csv{"t,true_x,true_y,true_yaw,fix,failure,features,matches,inliers,error_m,sigma_m,nees\n",
+                         std::ios_base::ate};
+
+  void Add(const QueryFrame& query, const visual_localization::LocalizationResult& result) {
     timings.push_back(result.timings);
     features.push_back(result.features);
     matches.push_back(result.matches);
@@ -173,7 +168,7 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
     if (!result.success) {
       ++failures[result.failure];
       csv << ",,\n";
-      continue;
+      return;
     }
     ++fixes;
     const Pose2 fix = ToPose2(result.T_map_base);
@@ -182,13 +177,28 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
     position_errors.push_back(error);
     heading_errors.push_back(std::abs(error3.z()) * 180.0 / M_PI);
     within_25cm += error <= 0.25 ? 1 : 0;
-    // Is the stated covariance what the error is? (3 on average when it is, as the trials' fixes.)
     nees.push_back(error3.dot(result.planar_covariance.ldlt().solve(error3)));
     const double sigma =
         std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(result.planar_covariance.topLeftCorner<2, 2>())
                       .eigenvalues()(1));
     csv << std::setprecision(4) << error << ',' << sigma << ',' << std::setprecision(3) << nees.back() << '\n';
   }
+};
+
+}  // namespace
+
+int RunLocalizationBench(const LocalizationEvalOptions& options) {
+  std::filesystem::create_directories(options.out_dir);
+  QueryDriveOptions query;
+  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
+  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
+  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
+  BenchTally tally;
+  for (const QueryFrame& query : drive.frames) {
+    tally.Add(query, localizer->Localize(query.frame, prior(query.T_map_base)));
+  }
+  const auto& [timings, position_errors, heading_errors, nees, fixes, within_25cm, features, matches, inliers, failures,
+               csv] = tally;
   const auto nees_within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
   const double n = std::max<double>(1, drive.frames.size());
   const ErrorStats position = ErrorStats::From(position_errors), heading = ErrorStats::From(heading_errors);

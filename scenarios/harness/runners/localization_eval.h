@@ -41,7 +41,8 @@ struct LocalizationEvalOptions {
   ProjectPaths paths;
 };
 
-// Writes localization_bench.json, localization_frames.csv and localization_time.png into out_dir; returns the exit code.
+// Writes localization_bench.json, localization_frames.csv and localization_time.png into out_dir;
+// returns the exit code.
 int RunLocalizationBench(const LocalizationEvalOptions& options);
 // Writes retrieval_eval.json into out_dir and prints the table; returns the exit code.
 int RunRetrievalEval(const LocalizationEvalOptions& options);
