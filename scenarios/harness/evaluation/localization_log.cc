@@ -1,8 +1,5 @@
 #include "evaluation/localization_log.h"
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
-
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -51,13 +48,12 @@ void LocalizationLog::AddFix(const stack::AppliedFix& applied, const TruePose* t
   Row& row = rows_[it->second];
   row.outcome = ToString(applied.outcome);
   const Eigen::Matrix3d& covariance = applied.fix.covariance;
-  row.sigma_m =
-      std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance.topLeftCorner<2, 2>()).eigenvalues()(1));
+  row.sigma_m = LargestPositionSigma(covariance);
   if (truth == nullptr) return;
   const Eigen::Vector3d error(applied.fix.x - truth->x, applied.fix.y - truth->y,
                               AngleDifference(applied.fix.yaw, truth->yaw));
   row.error_m = error.head<2>().norm();
-  row.nees = error.dot(covariance.ldlt().solve(error));
+  row.nees = PlanarNees(error, covariance);
 }
 
 std::map<std::string, int> LocalizationLog::Outcomes() const {

@@ -1,5 +1,8 @@
 #include "evaluation/pose_errors.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 
@@ -16,5 +19,13 @@ double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry
 }
 
 double AngleDifference(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
+
+double PlanarNees(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance) {
+  return error.dot(covariance.ldlt().solve(error));
+}
+
+double LargestPositionSigma(const Eigen::Matrix3d& covariance) {
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(covariance.topLeftCorner<2, 2>()).eigenvalues()(1));
+}
 
 }  // namespace trimbot::scenarios

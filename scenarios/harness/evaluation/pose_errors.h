@@ -9,5 +9,11 @@ double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isom
 double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
 // Planar heading difference a - b wrapped to [-pi, pi].
 double AngleDifference(double a, double b);
+// Normalized estimation error squared of a planar error (x, y, yaw) against the covariance the
+// estimate stated: 3 on average when the covariance is what the error is (not finite for a
+// singular covariance).
+double PlanarNees(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance);
+// The position sigma a planar covariance states along its worst axis (m).
+double LargestPositionSigma(const Eigen::Matrix3d& covariance);
 
 }  // namespace trimbot::scenarios

@@ -1,6 +1,5 @@
 #include "evaluation/trial_evaluator.h"
 
-#include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -130,7 +129,7 @@ void TrialEvaluator::Observe(const StepView& step) {
     AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
     // Is the fix's stated covariance what its error is? (NEES: 3 on average when it is.)
     const Eigen::Vector3d error(fix.x - at->x, fix.y - at->y, AngleDifference(fix.yaw, at->yaw));
-    const double nees = error.dot(fix.covariance.ldlt().solve(error));
+    const double nees = PlanarNees(error, fix.covariance);
     if (std::isfinite(nees)) fixes_.nees.push_back(nees);
   }
   if (have_previous_) path_length_ += std::hypot(truth.x - previous_.x, truth.y - previous_.y);
@@ -194,7 +193,7 @@ void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   sample_times_.push_back(step.time);
   AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
   const Eigen::Vector3d error(estimate.x - truth.x, estimate.y - truth.y, AngleDifference(estimate.yaw, truth.yaw));
-  const double nees = error.dot(step.telemetry->estimate.covariance.ldlt().solve(error));
+  const double nees = PlanarNees(error, step.telemetry->estimate.covariance);
   if (std::isfinite(nees)) ekf_.nees.push_back(nees);  // a covariance of zero (an exact start) has none
   AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);
   truth_tum_ += Tum(truth.t, {truth.x, truth.y, truth.yaw});

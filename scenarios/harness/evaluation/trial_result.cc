@@ -309,9 +309,8 @@ void AddLocalizationMetrics(const std::vector<TrialResult>& trials, nlohmann::js
     metrics[name + "_heading_error_max_deg"] = heading.max;
     const std::vector<double>& nees = pooled_nees[name];
     if (!nees.empty()) {
-      const auto within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
       metrics[name + "_nees_mean"] = ErrorStats::From(nees).mean;
-      metrics[name + "_nees_within_95_rate"] = static_cast<double>(within) / static_cast<double>(nees.size());
+      metrics[name + "_nees_within_95_rate"] = NeesWithin95Rate(nees);
     }
   }
 }
@@ -356,6 +355,12 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   AddBushMetrics(trials, metrics);
   AddArmMetrics(trials, metrics);
   return metrics;
+}
+
+double NeesWithin95Rate(const std::vector<double>& nees) {
+  if (nees.empty()) return 0.0;
+  const auto within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
+  return static_cast<double>(within) / static_cast<double>(nees.size());
 }
 
 }  // namespace trimbot::scenarios

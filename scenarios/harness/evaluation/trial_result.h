@@ -22,6 +22,8 @@ struct ErrorStats {
 // the estimate's own stamps (fixes) or at the evaluation rate (filters).
 // The 95 % quantile of the chi-square distribution with 3 degrees of freedom.
 constexpr double kChiSquare3Dof95 = 7.8147;
+// The share of these (3-dof) NEES values within the 95 % bound: 0.95 when consistent (0 for none).
+double NeesWithin95Rate(const std::vector<double>& nees);
 
 struct EstimateErrors {
   std::string name;

@@ -1,6 +1,5 @@
 #include "runners/localization_eval.h"
 
-#include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -177,51 +177,61 @@ struct BenchTally {
     position_errors.push_back(error);
     heading_errors.push_back(std::abs(error3.z()) * 180.0 / M_PI);
     within_25cm += error <= 0.25 ? 1 : 0;
-    nees.push_back(error3.dot(result.planar_covariance.ldlt().solve(error3)));
-    const double sigma =
-        std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(result.planar_covariance.topLeftCorner<2, 2>())
-                      .eigenvalues()(1));
-    csv << std::setprecision(4) << error << ',' << sigma << ',' << std::setprecision(3) << nees.back() << '\n';
+    nees.push_back(PlanarNees(error3, result.planar_covariance));
+    csv << std::setprecision(4) << error << ',' << LargestPositionSigma(result.planar_covariance) << ','
+        << std::setprecision(3) << nees.back() << '\n';
+  }
+};
+
+// What both evaluations start from: the output folder, the stack's localizer on the map, the
+// query drive's rendered frames and the noisy pose prior.
+struct QueryEvaluation {
+  QueryDriveOptions query;
+  std::unique_ptr<VisualLocalizer> localizer;
+  QueryDrive drive;
+  std::optional<NoisyPrior> prior;
+
+  explicit QueryEvaluation(const LocalizationEvalOptions& options) {
+    std::filesystem::create_directories(options.out_dir);
+    localizer = MakeLocalizer(options, &query);
+    drive = RenderQueryDrive(query, options.paths, options.out_dir);
+    prior.emplace(drive.setting.seed, options.prior_sigma);
   }
 };
 
 }  // namespace
 
 int RunLocalizationBench(const LocalizationEvalOptions& options) {
-  std::filesystem::create_directories(options.out_dir);
-  QueryDriveOptions query;
-  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
-  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
-  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
+  QueryEvaluation evaluation(options);
+  const QueryDrive& drive = evaluation.drive;
   BenchTally tally;
   for (const QueryFrame& query : drive.frames) {
-    tally.Add(query, localizer->Localize(query.frame, prior(query.T_map_base)));
+    tally.Add(query, evaluation.localizer->Localize(query.frame, (*evaluation.prior)(query.T_map_base)));
   }
-  const auto& [timings, position_errors, heading_errors, nees, fixes, within_25cm, features, matches, inliers, failures,
-               csv] = tally;
-  const auto nees_within = std::count_if(nees.begin(), nees.end(), [](double v) { return v <= kChiSquare3Dof95; });
   const double n = std::max<double>(1, drive.frames.size());
-  const ErrorStats position = ErrorStats::From(position_errors), heading = ErrorStats::From(heading_errors);
-  nlohmann::json report = DriveJson(options, query, drive);
+  const ErrorStats position = ErrorStats::From(tally.position_errors);
+  const ErrorStats heading = ErrorStats::From(tally.heading_errors);
+  const ErrorStats nees = ErrorStats::From(tally.nees);
+  const ErrorStats features = ErrorStats::From(tally.features), matches = ErrorStats::From(tally.matches),
+                   inliers = ErrorStats::From(tally.inliers);
+  const int fixes = tally.fixes, within_25cm = tally.within_25cm;
+  nlohmann::json report = DriveJson(options, evaluation.query, drive);
   report["fix_rate"] = fixes / n;
   report["fixes_within_25cm_rate"] = within_25cm / n;
   report["position_error_m"] = {{"mean", position.mean}, {"median", position.median}, {"max", position.max}};
   report["heading_error_deg"] = {{"mean", heading.mean}, {"median", heading.median}, {"max", heading.max}};
-  report["per_frame_median"] = {{"features", ErrorStats::From(features).median},
-                                {"matches", ErrorStats::From(matches).median},
-                                {"inliers", ErrorStats::From(inliers).median}};
-  report["nees"] = {{"mean", ErrorStats::From(nees).mean},
-                    {"median", ErrorStats::From(nees).median},
-                    {"within_95_rate", nees.empty() ? 0.0 : static_cast<double>(nees_within) / nees.size()}};
-  report["failures"] = failures;
-  report["time"] = LocalizationTimeStats(timings);
+  report["per_frame_median"] = {
+      {"features", features.median}, {"matches", matches.median}, {"inliers", inliers.median}};
+  report["nees"] = {{"mean", nees.mean}, {"median", nees.median}, {"within_95_rate", NeesWithin95Rate(tally.nees)}};
+  report["failures"] = tally.failures;
+  report["time"] = LocalizationTimeStats(tally.timings);
   report["threads"] = cv::getNumThreads();
   WriteFileAtomically(options.out_dir + "/localization_bench.json", report.dump(2));
-  WriteFileAtomically(options.out_dir + "/localization_frames.csv", csv.str());
+  WriteFileAtomically(options.out_dir + "/localization_frames.csv", tally.csv.str());
   WriteLocalizationTimeHistogram(options.out_dir + "/localization_time.png",
                                  "visual localization time per ring frame (" + std::to_string(drive.frames.size()) +
                                      " frames, " + std::to_string(cv::getNumThreads()) + " threads)",
-                                 timings);
+                                 tally.timings);
   const auto& t = report["time"];
   std::printf(
       "[bench] %zu frames: fixes %.1f %% (within 25 cm %.1f %%), position error mean %.2f / median %.2f cm, "
@@ -229,10 +239,9 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
       drive.frames.size(), 100 * fixes / n, 100 * within_25cm / n, 100 * position.mean, 100 * position.median,
       heading.mean);
   std::printf("[bench] fix consistency: NEES mean %.2f, median %.2f, %.1f %% within the 95 %% bound (3 dof)\n",
-              report["nees"]["mean"].get<double>(), report["nees"]["median"].get<double>(),
-              100 * report["nees"]["within_95_rate"].get<double>());
-  std::printf("[bench] per frame (median): %.0f features, %.0f matches, %.0f inliers\n",
-              ErrorStats::From(features).median, ErrorStats::From(matches).median, ErrorStats::From(inliers).median);
+              nees.mean, nees.median, 100 * report["nees"]["within_95_rate"].get<double>());
+  std::printf("[bench] per frame (median): %.0f features, %.0f matches, %.0f inliers\n", features.median,
+              matches.median, inliers.median);
   std::printf(
       "[bench] ms per frame, median (p90): features %.1f (%.1f), retrieval %.1f (%.1f), matching %.1f (%.1f), "
       "pose %.1f (%.1f); total %.1f (%.1f), mean %.1f\n",
@@ -245,11 +254,11 @@ int RunLocalizationBench(const LocalizationEvalOptions& options) {
 }
 
 int RunRetrievalEval(const LocalizationEvalOptions& options) {
-  std::filesystem::create_directories(options.out_dir);
-  QueryDriveOptions query;
-  const std::unique_ptr<VisualLocalizer> localizer = MakeLocalizer(options, &query);
-  const QueryDrive drive = RenderQueryDrive(query, options.paths, options.out_dir);
-  NoisyPrior prior(drive.setting.seed, options.prior_sigma);
+  QueryEvaluation evaluation(options);
+  const QueryDriveOptions& query = evaluation.query;
+  const std::unique_ptr<VisualLocalizer>& localizer = evaluation.localizer;
+  const QueryDrive& drive = evaluation.drive;
+  NoisyPrior& prior = *evaluation.prior;
   constexpr std::array<int, 3> kThresholds = {50, 100, 200};
   const std::array<std::pair<Retrieval, const char*>, 3> methods = {{{Retrieval::kVocabulary, "vocabulary"},
                                                                      {Retrieval::kPosePrior, "pose_prior"},
