@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,6 +35,9 @@ OccupancyGrid WallMap() {
   }
   return OccupancyGrid(occupied, resolution, {0.0, 0.0});
 }
+
+// The URDF's base outline (chassis 0.70 m long from x = -0.12, wheels' outer faces at +-0.255 m).
+const BaseOutline kOutline({-0.12, -0.255}, {0.58, 0.255});
 
 // A differential-drive base that does exactly what it is told.
 Pose2 Integrate(const Pose2& pose, const messages::BaseVelocityCommand& command, double dt) {
@@ -90,8 +94,8 @@ TEST(OccupancyGrid, LoadsMapServerFilesAndNamesTheFileOnErrors) {
 TEST(GlobalPlanner, PlansAroundAWallKeepingTheClearance) {
   SeedPlanner(7);
   const OccupancyGrid map = WallMap();
-  const GlobalPlanner planner(map, PlannerParameters{});
-  const PlanResult plan = planner.Plan({2.0, 2.0}, {8.0, 2.0});
+  const GlobalPlanner planner(map, kOutline, PlannerParameters{});
+  const PlanResult plan = planner.Plan({2.0, 2.0, 0.0}, {8.0, 2.0}, 0.025);
   ASSERT_TRUE(plan.found) << plan.message;
   EXPECT_NEAR((plan.path.front() - Eigen::Vector2d(2.0, 2.0)).norm(), 0.0, 1e-9);
   EXPECT_NEAR((plan.path.back() - Eigen::Vector2d(8.0, 2.0)).norm(), 0.0, 0.05);
@@ -100,9 +104,13 @@ TEST(GlobalPlanner, PlansAroundAWallKeepingTheClearance) {
   EXPECT_LT(plan.length, 13.0) << "a detour far beyond the gap";
   bool went_over_the_wall = false;
   for (std::size_t i = 1; i < plan.path.size(); ++i) {
+    const Eigen::Vector2d d = plan.path[i] - plan.path[i - 1];
+    const double heading = std::atan2(d.y(), d.x());
     for (double f = 0.0; f <= 1.0; f += 0.02) {
-      const Eigen::Vector2d p = plan.path[i - 1] + f * (plan.path[i] - plan.path[i - 1]);
-      EXPECT_GE(map.DistanceToObstacle(p), planner.parameters().robot_radius - 0.03) << p.transpose();
+      const Eigen::Vector2d p = plan.path[i - 1] + f * d;
+      // The outline driving the segment keeps the clearance (less the half step between checks).
+      EXPECT_GE(planner.Clearance({p.x(), p.y(), heading}), planner.parameters().min_clearance - 0.0125)
+          << p.transpose();
       went_over_the_wall = went_over_the_wall || (std::abs(p.x() - 5.0) < 0.3 && p.y() > 6.0);
     }
   }
@@ -116,13 +124,13 @@ TEST(GlobalPlanner, ReportsUnreachableAndBlockedGoals) {
   const OccupancyGrid map(occupied, 0.05, {0.0, 0.0});
   PlannerParameters parameters;
   parameters.iterations = 500;
-  const GlobalPlanner planner(map, parameters);
+  const GlobalPlanner planner(map, kOutline, parameters);
   const Eigen::Vector2d inside_box(3.75, 3.25);
-  ASSERT_TRUE(planner.Free(inside_box));
-  const PlanResult enclosed = planner.Plan({1.0, 1.0}, inside_box);
+  ASSERT_TRUE(planner.FreeHeading(inside_box).has_value());
+  const PlanResult enclosed = planner.Plan({1.0, 1.0, 0.0}, inside_box, 0.025);
   EXPECT_FALSE(enclosed.found);
   EXPECT_FALSE(enclosed.message.empty());
-  const PlanResult on_wall = planner.Plan({1.0, 1.0}, {3.0, 2.5});
+  const PlanResult on_wall = planner.Plan({1.0, 1.0, 0.0}, {3.0, 2.5}, 0.025);
   EXPECT_FALSE(on_wall.found);
   EXPECT_NE(on_wall.message.find("goal"), std::string::npos) << on_wall.message;
 }
@@ -150,7 +158,7 @@ TEST(PathFollower, DrivesAnLShapedPathTurningOnTheSpotAtTheCorner) {
 TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   SeedPlanner(11);
   const OccupancyGrid map = WallMap();
-  Navigator navigator(map, NavigatorParameters{});
+  Navigator navigator(map, kOutline, NavigatorParameters{});
   navigator.SetGoals({{8.0, 2.0}, {2.0, 1.5}});
   Pose2 pose{2.0, 2.0, M_PI / 2};
   std::vector<NavigationEvent> events;
@@ -158,7 +166,7 @@ TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   double closest = 1e9;
   for (; t < 400.0 && navigator.mode() != Navigator::Mode::kDone; t += 0.05) {
     pose = Integrate(pose, navigator.Update(t, pose), 0.05);
-    closest = std::min(closest, navigator.FootprintClearance(pose));
+    closest = std::min(closest, navigator.OutlineClearance(pose));
     for (const auto& e : navigator.TakeEvents()) events.push_back(e);
   }
   ASSERT_EQ(navigator.mode(), Navigator::Mode::kDone);
@@ -166,17 +174,17 @@ TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   for (const auto& e : events) reached += e.type == NavigationEvent::Type::kGoalReached ? 1 : 0;
   EXPECT_EQ(reached, 2);
   EXPECT_LT(std::hypot(pose.x - 2.0, pose.y - 1.5), 0.1);
-  EXPECT_GT(closest, 0.03) << "the footprint came closer to the wall than the stop distance";
+  EXPECT_GT(closest, 0.03) << "the outline came closer to the wall than the stop distance";
 
-  // Driving north along the wall, 0.5 m from it, the estimate jumps 0.25 m towards the wall (a
-  // re-localization): the footprint is now within the stop distance while moving - stop, back off.
-  Navigator stopper(map, NavigatorParameters{});
+  // Driving north along the wall, 0.5 m from it, the estimate jumps 0.45 m towards the wall (a
+  // re-localization): the outline now overlaps it while moving - stop, back off.
+  Navigator stopper(map, kOutline, NavigatorParameters{});
   stopper.SetGoals({{4.3, 5.5}});
   Pose2 truth{4.3, 1.0, M_PI / 2};
   bool stopped = false, backed = false;
   for (int k = 0; k < 400 && !backed; ++k) {
     Pose2 estimate = truth;
-    if (k >= 100) estimate.x += 0.25;
+    if (k >= 100) estimate.x += 0.45;
     const auto command = stopper.Update(k * 0.05, estimate);
     for (const auto& e : stopper.TakeEvents()) stopped = stopped || e.type == NavigationEvent::Type::kObstacleStop;
     backed = command.linear < 0.0;
@@ -208,11 +216,11 @@ int Count(const std::vector<NavigationEvent>& events, NavigationEvent::Type type
 }
 
 // An obstacle the prior map lacks appears on the path (perception's costmap): the navigator plans
-// again and goes around it, never closer than the footprint allows.
+// again and goes around it, its outline never touching the box.
 TEST(Navigator, PlansAgainWhenASeenObstacleBlocksThePath) {
   SeedPlanner(12);
   const OccupancyGrid map = WallMap();
-  Navigator navigator(map, NavigatorParameters{});
+  Navigator navigator(map, kOutline, NavigatorParameters{});
   navigator.SetGoals({{3.8, 7.0}});
   Pose2 pose{3.8, 0.8, M_PI / 2};
   const Eigen::Vector2d box(3.8, 4.0);  // 0.4 m square, on the straight line to the goal
@@ -220,6 +228,7 @@ TEST(Navigator, PlansAgainWhenASeenObstacleBlocksThePath) {
   for (double x = box.x() - 0.2; x <= box.x() + 0.2; x += 0.025) {
     for (double y = box.y() - 0.2; y <= box.y() + 0.2; y += 0.025) occupied.at<uchar>(map.Cell({x, y})) = 255;
   }
+  const OccupancyGrid seen_map(occupied, map.resolution(), map.origin());
   bool seen = false;
   double closest = 1e9;
   int step = 0;
@@ -229,43 +238,103 @@ TEST(Navigator, PlansAgainWhenASeenObstacleBlocksThePath) {
       navigator.SetCostmap(OccupancyGrid(occupied, map.resolution(), map.origin()));
       seen = true;
     }
-    closest = std::min(closest, (Eigen::Vector2d(p.x, p.y) - box).cwiseAbs().maxCoeff() - 0.2);
+    closest = std::min(closest, kOutline.Clearance(seen_map, p));
   });
   EXPECT_EQ(navigator.mode(), Navigator::Mode::kDone);
   EXPECT_EQ(Count(events, NavigationEvent::Type::kPathBlocked), 1) << "blocked once, then planned around";
   EXPECT_EQ(Count(events, NavigationEvent::Type::kGoalReached), 1);
-  EXPECT_GT(closest, 0.4) << "base_link came within " << closest << " m of the box";
+  EXPECT_GT(closest, NavigatorParameters{}.stop_clearance) << "the outline came within " << closest << " m of the box";
   EXPECT_LT(std::hypot(pose.x - 3.8, pose.y - 7.0), 0.1);
 }
 
-// A goal 0.3 m from an obstacle (inside the planner's 0.5 m clearance) is not refused: it is
-// reached at the nearest point the robot can arrive at facing any way (the footprint's reach,
-// 0.71 m, plus its 0.1 m margin from the obstacle), and the event says where.
-TEST(Navigator, GoalNearAnObstacleIsReachedAtTheNearestFeasiblePoint) {
+// A goal 0.3 m from a wall, where the base fits beside the wall with 4.5 cm to spare (less than
+// the planner's 5 cm): reached within a cell or two of where it was asked. A goal inside the wall is
+// moved to the nearest position where the outline fits (0.5 m out), and refused with the reason
+// when goal_search_radius does not reach that far.
+TEST(Navigator, GoalNearAnObstacleIsReachedWhereTheOutlineFits) {
   SeedPlanner(13);
   const OccupancyGrid map = WallMap();
   const NavigatorParameters parameters;
-  Navigator navigator(map, parameters);
-  const Eigen::Vector2d goal(4.5, 3.0);  // the wall starts at x = 4.8
-  navigator.SetGoals({goal});
-  Pose2 pose{1.5, 3.0, 0.0};
-  const auto events = DriveUntilDone(navigator, pose, [](double, const Pose2&) {});
-  ASSERT_EQ(navigator.mode(), Navigator::Mode::kDone);
-  const auto adjusted = std::find_if(events.begin(), events.end(),
-                                     [](const auto& e) { return e.type == NavigationEvent::Type::kGoalAdjusted; });
-  ASSERT_NE(adjusted, events.end());
-  EXPECT_NEAR(map.DistanceToObstacle(adjusted->position), 0.81, 0.05);
-  EXPECT_NEAR((adjusted->position - goal).norm(), 0.51, 0.05) << "straight back from the wall";
-  EXPECT_LT(std::hypot(pose.x - adjusted->position.x(), pose.y - adjusted->position.y()), 0.1);
-  // Within goal_search_radius no point is clear enough: the goal is refused as before.
+  const auto drive_to = [&](const Eigen::Vector2d& goal, const NavigatorParameters& p, Navigator::Mode* mode,
+                            Pose2* end) {
+    Navigator navigator(map, kOutline, p);
+    navigator.SetGoals({goal});
+    *end = {1.5, 3.0, 0.0};
+    const auto events = DriveUntilDone(navigator, *end, [](double, const Pose2&) {});
+    *mode = navigator.mode();
+    return events;
+  };
+  const auto adjusted_to = [](const std::vector<NavigationEvent>& events) -> std::optional<Eigen::Vector2d> {
+    for (const auto& e : events) {
+      if (e.type == NavigationEvent::Type::kGoalAdjusted) return e.position;
+    }
+    return std::nullopt;
+  };
+  Navigator::Mode mode;
+  Pose2 end;
+  const Eigen::Vector2d beside(4.5, 3.0);  // the wall starts at x = 4.8
+  auto events = drive_to(beside, parameters, &mode, &end);
+  for (const auto& e : events) std::printf("%.2f %s %s\n", e.stamp, ToString(e.type), e.detail.c_str());
+  ASSERT_EQ(mode, Navigator::Mode::kDone);
+  const Eigen::Vector2d used = adjusted_to(events).value_or(beside);
+  EXPECT_LT((used - beside).norm(), 0.1);
+  EXPECT_LT(std::hypot(end.x - used.x(), end.y - used.y()), 0.1);
+  EXPECT_GE(kOutline.Clearance(map, end), 0.0);
+
+  const Eigen::Vector2d in_the_wall(5.0, 3.0);
+  events = drive_to(in_the_wall, parameters, &mode, &end);
+  ASSERT_EQ(mode, Navigator::Mode::kDone);
+  const auto moved = adjusted_to(events);
+  ASSERT_TRUE(moved.has_value());
+  // Straight back from the wall: base_link 0.255 + 0.05 m from its face at x = 4.8 (to a cell).
+  EXPECT_NEAR(moved->x(), 4.8 - 0.255 - 0.05, 0.06);
+  EXPECT_NEAR(moved->y(), 3.0, 0.06);
+
   NavigatorParameters strict = parameters;
   strict.goal_search_radius = 0.3;
-  Navigator refusing(map, strict);
-  refusing.SetGoals({goal});
-  Pose2 start{1.5, 3.0, 0.0};
-  const auto refused = DriveUntilDone(refusing, start, [](double, const Pose2&) {});
-  EXPECT_EQ(refusing.mode(), Navigator::Mode::kFailed);
-  EXPECT_EQ(Count(refused, NavigationEvent::Type::kGoalAdjusted), 0);
+  events = drive_to(in_the_wall, strict, &mode, &end);
+  EXPECT_EQ(mode, Navigator::Mode::kFailed);
+  EXPECT_EQ(Count(events, NavigationEvent::Type::kGoalAdjusted), 0);
+  const auto failed = std::find_if(events.begin(), events.end(),
+                                   [](const auto& e) { return e.type == NavigationEvent::Type::kGoalFailed; });
+  ASSERT_NE(failed, events.end());
+  EXPECT_NE(failed->detail.find("fits nowhere"), std::string::npos) << failed->detail;
+}
+
+// A gap between two walls 0.2 m wider than the base is passed; one 0.05 m narrower than the base
+// is refused, with the reason, and never driven into.
+TEST(GlobalPlanner, PassesAGapWiderThanTheBaseAndRefusesANarrowerOne) {
+  for (const double extra : {0.2, -0.05}) {
+    SeedPlanner(14);
+    const double gap = kOutline.width() + extra;
+    // A wall across x in [2.0, 2.4] with a gap centred on y = 3 (map 6 x 6 m).
+    cv::Mat occupied(120, 120, CV_8U, cv::Scalar(0));
+    const OccupancyGrid empty(occupied, 0.05, {0.0, 0.0});
+    for (int row = 0; row < occupied.rows; ++row) {
+      for (int column = 0; column < occupied.cols; ++column) {
+        const Eigen::Vector2d c = empty.CellCentre({column, row});
+        if (c.x() > 2.0 && c.x() < 2.4 && std::abs(c.y() - 3.0) > 0.5 * gap) occupied.at<uchar>(row, column) = 255;
+      }
+    }
+    const OccupancyGrid map(occupied, 0.05, {0.0, 0.0});
+    PlannerParameters parameters;
+    parameters.iterations = 3000;
+    const GlobalPlanner planner(map, kOutline, parameters);
+    const PlanResult plan = planner.Plan({0.8, 2.0, 0.0}, {4.0, 4.0}, 0.025);
+    if (extra > 0.0) {
+      ASSERT_TRUE(plan.found) << "gap " << gap << " m: " << plan.message;
+      for (std::size_t i = 1; i < plan.path.size(); ++i) {
+        const Eigen::Vector2d d = plan.path[i] - plan.path[i - 1];
+        for (double f = 0.0; f <= 1.0; f += 0.01) {
+          const Eigen::Vector2d p = plan.path[i - 1] + f * d;
+          EXPECT_GE(planner.Clearance({p.x(), p.y(), std::atan2(d.y(), d.x())}), 0.0) << p.transpose();
+        }
+      }
+    } else {
+      EXPECT_FALSE(plan.found) << "gap " << gap << " m narrower than the base";
+      EXPECT_FALSE(plan.message.empty());
+    }
+  }
 }
 
 // The bush servo on a kinematic base: from 1.5 m off, with measurements of the bush's centre

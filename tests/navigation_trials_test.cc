@@ -23,6 +23,7 @@
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
+#include "trimbot/robot/robot_files.h"
 #include "trimbot/stack/global_planner.h"
 #include "trimbot/stack/occupancy_grid.h"
 #include "trimbot/stack/stack_parameters.h"
@@ -62,20 +63,26 @@ TEST(Scenario, TheRealRobotsTrialSetsLoad) {
 }
 
 // Between consecutive hourglass goals the straight line is blocked for the robot (as in the real
-// trials, it has to plan around the bushes).
+// trials, it has to plan around the bushes), and the base fits at every goal.
 TEST(Scenario, HourglassHasNoStraightPathBetweenGoals) {
   const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/hourglass.yaml"));
   const garden::OccupancyMap prior = PrepareTrial(s, ProjectPaths{TRIMBOT_SOURCE_DIR}).prior_map;
   const stack::OccupancyGrid map(prior.occupied, prior.resolution, prior.origin);
-  const double radius = stack::PlannerParameters{}.robot_radius;
+  const auto [outline_min, outline_max] =
+      robot::RobotDescription::Load(robot::RobotFiles::InFolder(testing::SourcePath("robot")).urdf).BaseOutline();
+  const stack::GlobalPlanner planner(map, stack::BaseOutline(outline_min, outline_max), stack::PlannerParameters{});
+  const double wanted = planner.parameters().min_clearance;
   Eigen::Vector2d from(s.setting.start.x, s.setting.start.y);
   for (const auto& scenario_goal : s.goals) {
     const Eigen::Vector2d goal = scenario_goal.position;
-    EXPECT_GE(map.DistanceToObstacle(goal), radius) << "goal " << goal.transpose() << " is not reachable";
+    EXPECT_TRUE(planner.FreeHeading(goal).has_value()) << "goal " << goal.transpose() << " is not reachable";
+    const double heading = std::atan2(goal.y() - from.y(), goal.x() - from.x());
     double closest = 1e9;
-    for (double f = 0.0; f <= 1.0; f += 0.005)
-      closest = std::min(closest, map.DistanceToObstacle(from + f * (goal - from)));
-    EXPECT_LT(closest, radius) << "straight path from " << from.transpose() << " to " << goal.transpose();
+    for (double f = 0.0; f <= 1.0; f += 0.005) {
+      const Eigen::Vector2d q = from + f * (goal - from);
+      closest = std::min(closest, planner.Clearance({q.x(), q.y(), heading}));
+    }
+    EXPECT_LT(closest, wanted) << "straight path from " << from.transpose() << " to " << goal.transpose();
     from = goal;
   }
 }

@@ -1,7 +1,9 @@
 #include "trimbot/stack/global_planner.h"
 
-#include <ompl/base/objectives/PathLengthOptimizationObjective.h>
-#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/Goal.h>
+#include <ompl/base/OptimizationObjective.h>
+#include <ompl/base/goals/GoalStates.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
 #include <ompl/base/terminationconditions/IterationTerminationCondition.h>
 #include <ompl/geometric/PathGeometric.h>
 #include <ompl/geometric/PathSimplifier.h>
@@ -9,11 +11,11 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
-#include "trimbot/common/random.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "trimbot/common/random.h"
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
@@ -22,62 +24,134 @@ namespace trimbot::stack {
 
 namespace {
 
-Eigen::Vector2d Point(const ob::State* state) {
-  const auto* s = state->as<ob::RealVectorStateSpace::StateType>();
-  return {s->values[0], s->values[1]};
+constexpr int kHeadings = 32;  // headings tried where a pose must fit (goals, escapes)
+
+// To [-pi, pi), OMPL's SO(2) bounds.
+double WrapAngle(double angle) {
+  const double wrapped = std::remainder(angle, 2.0 * M_PI);
+  return wrapped >= M_PI ? wrapped - 2.0 * M_PI : wrapped;
 }
 
-// A straight motion is valid when base_link keeps its clearance all along it and the footprint,
-// pointing along the motion, keeps its margin. Checked every half map cell.
-class FootprintMotionValidator : public ob::MotionValidator {
- public:
-  FootprintMotionValidator(const ob::SpaceInformationPtr& si, const GlobalPlanner& planner,
-                           const Eigen::Vector2d& start)
-      : ob::MotionValidator(si), planner_(planner), start_(start) {}
+Pose2 ToPose(const ob::State* state) {
+  const auto* s = state->as<ob::SE2StateSpace::StateType>();
+  return {s->getX(), s->getY(), s->getYaw()};
+}
 
-  bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
-    std::pair<ob::State*, double> unused{nullptr, 0.0};
-    return checkMotion(s1, s2, unused);
+void SetPose(const Pose2& pose, ob::State* state) {
+  auto* s = state->as<ob::SE2StateSpace::StateType>();
+  s->setXY(pose.x, pose.y);
+  s->setYaw(WrapAngle(pose.yaw));
+}
+
+// The clearance each pose of a plan must keep: min_clearance, except near the start, where the
+// robot may stand closer after a stop and must only get no closer than it is.
+class ClearanceRule {
+ public:
+  ClearanceRule(const GlobalPlanner& planner, const Pose2& start) : planner_(planner), start_(start.x, start.y) {
+    const double at_start = planner.Clearance(start, planner.parameters().min_clearance);
+    near_start_ = std::min(planner.parameters().min_clearance, at_start - 1e-3);
   }
-  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override {
-    const Eigen::Vector2d a = Point(s1), b = Point(s2);
-    const double length = (b - a).norm();
-    const double yaw = std::atan2(b.y() - a.y(), b.x() - a.x());
-    const auto& p = planner_.parameters();
-    const int steps = std::max(1, static_cast<int>(std::ceil(length / (0.5 * planner_.map().resolution()))));
-    for (int i = 1; i <= steps; ++i) {
-      const double f = static_cast<double>(i) / steps;
-      const Eigen::Vector2d q = a + f * (b - a);
-      const bool check_footprint = length > 1e-9 && (q - start_).norm() > p.start_footprint_free;
-      const bool valid = planner_.Free(q) && (!check_footprint || p.footprint.Clearance(planner_.map(), q.x(), q.y(),
-                                                                                        yaw) >= p.footprint_margin);
-      if (!valid) {
-        const double last = static_cast<double>(i - 1) / steps;
-        if (last_valid.first != nullptr) si_->getStateSpace()->interpolate(s1, s2, last, last_valid.first);
-        last_valid.second = last;
-        invalid_++;
-        return false;
-      }
-    }
-    valid_++;
-    return true;
+  double At(const Eigen::Vector2d& position) const {
+    return (position - start_).norm() < planner_.parameters().start_free_radius ? near_start_
+                                                                                : planner_.parameters().min_clearance;
   }
 
  private:
   const GlobalPlanner& planner_;
   Eigen::Vector2d start_;
+  double near_start_ = 0.0;
+};
+
+// Whether the outline keeps `wanted` along the straight motion from `from` to `to` at `heading`,
+// given lower bounds of its clearance at both ends. The clearance changes by at most the distance
+// moved, so an interval whose ends' bound (c0 + c1 - length) / 2 reaches `wanted` is clear;
+// otherwise it is split, down to 1 mm (where the ends' own clearances decide).
+bool StraightClear(const GlobalPlanner& planner, const ClearanceRule& rule, const Eigen::Vector2d& from,
+                   const Eigen::Vector2d& to, double heading, double c0, double c1) {
+  const double length = (to - from).norm();
+  const double wanted = std::max(rule.At(from), rule.At(to));
+  if (c0 < rule.At(from) || c1 < rule.At(to)) return false;
+  if (0.5 * (c0 + c1 - length) >= wanted) return true;
+  if (length < 1e-3) return true;
+  const Eigen::Vector2d middle = 0.5 * (from + to);
+  const double c = planner.Clearance({middle.x(), middle.y(), heading}, wanted + 0.5 * length);
+  return StraightClear(planner, rule, from, middle, heading, c0, c) &&
+         StraightClear(planner, rule, middle, to, heading, c, c1);
+}
+
+// Whether the drive's motion a -> b (turn to face b, straight, turn to b's heading) keeps the
+// rule's clearance at every pose: the straight part sampled every half cell and then exactly
+// (StraightClear), the turns every half cell of the outline's farthest corner's travel.
+bool MotionClear(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& a, const Pose2& b) {
+  const OccupancyGrid& map = planner.map();
+  const BaseOutline& outline = planner.outline();
+  const double step = 0.5 * map.resolution();
+  const Eigen::Vector2d from(a.x, a.y), to(b.x, b.y);
+  const double length = (to - from).norm();
+  if (length < 1e-9) return outline.TurnClearance(map, a, b.yaw, step, rule.At(from)) >= rule.At(from);
+  const double heading = std::atan2(to.y() - from.y(), to.x() - from.x());
+  if (outline.TurnClearance(map, a, heading, step, rule.At(from)) < rule.At(from)) return false;
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
+  const double piece = length / steps;
+  Eigen::Vector2d previous = from;
+  double previous_clearance = planner.Clearance({from.x(), from.y(), heading}, rule.At(from) + piece);
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Vector2d q = from + (static_cast<double>(k) / steps) * (to - from);
+    const double clearance = planner.Clearance({q.x(), q.y(), heading}, rule.At(q) + piece);
+    if (!StraightClear(planner, rule, previous, q, heading, previous_clearance, clearance)) return false;
+    previous = q;
+    previous_clearance = clearance;
+  }
+  return outline.TurnClearance(map, {b.x, b.y, heading}, b.yaw, step, rule.At(to)) >= rule.At(to);
+}
+
+class DriveMotionValidator : public ob::MotionValidator {
+ public:
+  DriveMotionValidator(const ob::SpaceInformationPtr& si, const GlobalPlanner& planner, const ClearanceRule& rule)
+      : ob::MotionValidator(si), planner_(planner), rule_(rule) {}
+
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
+    const bool valid = MotionClear(planner_, rule_, ToPose(s1), ToPose(s2));
+    (valid ? valid_ : invalid_)++;
+    return valid;
+  }
+  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override {
+    // Only the verdict is used by the planners run here (RRT*, the simplifier); report no progress.
+    const bool valid = checkMotion(s1, s2);
+    if (!valid) {
+      if (last_valid.first != nullptr) si_->copyState(last_valid.first, s1);
+      last_valid.second = 0.0;
+    }
+    return valid;
+  }
+
+ private:
+  const GlobalPlanner& planner_;
+  const ClearanceRule& rule_;
+};
+
+// Path cost: the drive's motion cost (GlobalPlanner::MotionCost); the straight distance is its
+// admissible heuristic.
+class DriveObjective : public ob::OptimizationObjective {
+ public:
+  DriveObjective(const ob::SpaceInformationPtr& si, const GlobalPlanner& planner)
+      : ob::OptimizationObjective(si), planner_(planner) {
+    description_ = "drive time and clearance";
+  }
+  ob::Cost stateCost(const ob::State*) const override { return identityCost(); }
+  ob::Cost motionCost(const ob::State* s1, const ob::State* s2) const override {
+    return ob::Cost(planner_.MotionCost(ToPose(s1), ToPose(s2)));
+  }
+  ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
+    const Pose2 a = ToPose(s1), b = ToPose(s2);
+    return ob::Cost(std::hypot(b.x - a.x, b.y - a.y));
+  }
+
+ private:
+  const GlobalPlanner& planner_;
 };
 
 }  // namespace
-
-double Footprint::Clearance(const OccupancyGrid& map, double x, double y, double yaw) const {
-  double clearance = std::numeric_limits<double>::infinity();
-  for (double cx : circle_x) {
-    const Eigen::Vector2d centre(x + cx * std::cos(yaw), y + cx * std::sin(yaw));
-    clearance = std::min(clearance, map.DistanceToObstacle(centre) - circle_radius);
-  }
-  return clearance;
-}
 
 void SeedPlanner(std::uint64_t seed) {
   // OMPL takes 32 bits and refuses 0: mix all 64 bits so nearby or 2^32-apart seeds differ.
@@ -85,141 +159,234 @@ void SeedPlanner(std::uint64_t seed) {
   ompl::RNG::setSeed(mixed == 0 ? 0x9e3779b9u : mixed);
 }
 
-GlobalPlanner::GlobalPlanner(const OccupancyGrid& map, const PlannerParameters& parameters)
-    : map_(map), parameters_(parameters) {
+GlobalPlanner::GlobalPlanner(const OccupancyGrid& map, const BaseOutline& outline, const PlannerParameters& parameters)
+    : map_(map), outline_(outline), parameters_(parameters) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 }
 
-bool GlobalPlanner::Free(const Eigen::Vector2d& point) const {
-  return map_.DistanceToObstacle(point) >= parameters_.robot_radius;
+double GlobalPlanner::Clearance(const Pose2& pose, double enough) const {
+  return outline_.Clearance(map_, pose, enough);
 }
 
-Eigen::Vector2d GlobalPlanner::NearestFree(const Eigen::Vector2d& point, double radius) const {
-  return NearestWithClearance(point, parameters_.robot_radius, radius).value_or(point);
-}
-
-double GlobalPlanner::ArrivalClearance() const {
-  const Footprint& f = parameters_.footprint;
-  double reach = 0.0;
-  for (double x : f.circle_x) reach = std::max(reach, std::abs(x) + f.circle_radius);
-  return std::max(parameters_.robot_radius, reach + parameters_.footprint_margin);
-}
-
-std::optional<Eigen::Vector2d> GlobalPlanner::NearestWithClearance(const Eigen::Vector2d& point, double clearance,
-                                                                   double radius) const {
-  if (map_.DistanceToObstacle(point) >= clearance) return point;
-  // Rings of growing radius, 32 directions each: the first point found is the nearest (to within
-  // the ring spacing).
-  const double step = map_.resolution();
-  for (double r = step; r <= radius + 1e-9; r += step) {
-    for (int k = 0; k < 32; ++k) {
-      const double a = 2.0 * M_PI * k / 32.0;
-      const Eigen::Vector2d candidate = point + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-      if (map_.DistanceToObstacle(candidate) >= clearance) return candidate;
-    }
-  }
-  return std::nullopt;
+bool GlobalPlanner::Valid(const Pose2& pose) const {
+  return Clearance(pose, parameters_.min_clearance) >= parameters_.min_clearance;
 }
 
 namespace {
 
-// m: where the planner arrives from when RRT* cannot join the goal itself (GlobalPlanner::Plan).
-constexpr double kGoalApproach = 0.4;
-
-// The motion validator's verdict on the straight segment a -> b.
-bool Motion(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
-  from[0] = a.x();
-  from[1] = a.y();
-  to[0] = b.x();
-  to[1] = b.y();
-  return si->checkMotion(from.get(), to.get());
-}
-
-// RRT* from `start` to `goal` on `si`, simplified; nullopt (with the reason in `*message`) when
-// the iterations found no exact solution.
-std::optional<std::vector<Eigen::Vector2d>> RrtStar(const ob::SpaceInformationPtr& si, const Eigen::Vector2d& start,
-                                                    const Eigen::Vector2d& goal, double resolution, double range,
-                                                    unsigned iterations, std::string* message) {
-  ob::ScopedState<ob::RealVectorStateSpace> from(si->getStateSpace()), to(si->getStateSpace());
-  from[0] = start.x();
-  from[1] = start.y();
-  to[0] = goal.x();
-  to[1] = goal.y();
-  auto problem = std::make_shared<ob::ProblemDefinition>(si);
-  problem->setStartAndGoalStates(from, to, 0.5 * resolution);
-  problem->setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(si));
-  auto planner = std::make_shared<og::RRTstar>(si);
-  planner->setRange(range);
-  planner->setProblemDefinition(problem);
-  planner->setup();
-  ob::IterationTerminationCondition budget(iterations);
-  const ob::PlannerStatus status = planner->solve(budget);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
-    if (message != nullptr) {
-      *message = std::string("no path found (") + status.asString() + ", " +
-                 std::to_string(problem->getSolutionDifference()) + " m short)";
-    }
-    return std::nullopt;
+// Of kHeadings headings at `position`, the one with the most clearance and that clearance.
+std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
+  std::pair<double, double> best{0.0, -std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < kHeadings; ++k) {
+    const double yaw = WrapAngle(2.0 * M_PI * k / kHeadings);
+    const double clearance = planner.Clearance({position.x(), position.y(), yaw});
+    if (clearance > best.second) best = {yaw, clearance};
   }
-  auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
-  og::PathSimplifier simplifier(si);
-  simplifier.simplifyMax(path);
-  std::vector<Eigen::Vector2d> points;
-  for (const ob::State* state : path.getStates()) points.push_back(Point(state));
-  // RRT* stops within half a cell of the goal: end on the goal itself when that last step is free.
-  if (points.back() != goal && Motion(si, points.back(), goal)) points.push_back(goal);
-  return points;
+  return best;
 }
 
 }  // namespace
 
-PlanResult GlobalPlanner::Plan(const Eigen::Vector2d& start, const Eigen::Vector2d& goal, int attempt) const {
+std::optional<double> GlobalPlanner::FreeHeading(const Eigen::Vector2d& position) const {
+  const auto [yaw, clearance] = BestHeading(*this, position);
+  if (clearance < parameters_.min_clearance) return std::nullopt;
+  return yaw;
+}
+
+std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vector2d& point, double radius,
+                                                                int count) const {
+  std::vector<Eigen::Vector2d> positions;
+  if (count <= 0) return positions;
+  if (FreeHeading(point)) positions.push_back(point);
+  const double step = map_.resolution();
+  for (double r = step; r <= radius + 1e-9 && static_cast<int>(positions.size()) < count; r += step) {
+    // Within a ring, the roomiest first: where the outline has more clearance it can also turn.
+    std::vector<std::pair<double, Eigen::Vector2d>> ring;
+    const int around = std::max(8, static_cast<int>(std::ceil(2.0 * M_PI * r / step)));
+    for (int k = 0; k < around; ++k) {
+      const double a = 2.0 * M_PI * k / around;
+      const Eigen::Vector2d candidate = point + r * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const double clearance = BestHeading(*this, candidate).second;
+      if (clearance >= parameters_.min_clearance) ring.emplace_back(clearance, candidate);
+    }
+    std::stable_sort(ring.begin(), ring.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    for (const auto& [clearance, candidate] : ring) {
+      if (static_cast<int>(positions.size()) < count) positions.push_back(candidate);
+    }
+  }
+  return positions;
+}
+
+double GlobalPlanner::MotionCost(const Pose2& a, const Pose2& b) const {
+  const double length = std::hypot(b.x - a.x, b.y - a.y);
+  if (length < 1e-9) return parameters_.turn_cost * std::abs(WrapAngle(b.yaw - a.yaw));
+  const double heading = std::atan2(b.y - a.y, b.x - a.x);
+  double cost = length + parameters_.turn_cost *
+                             (std::abs(WrapAngle(heading - a.yaw)) + std::abs(WrapAngle(b.yaw - heading)));
+  // Clearance below the preferred costs extra, sampled at the middles of 0.2 m pieces. For speed
+  // (RRT* costs every candidate edge: this is most of its time) the clearance here is the distance
+  // from the outline's centre to the nearest occupied cell less its half width - exact beside a
+  // wall, more than the outline's own clearance ahead and behind. The walls are checked exactly.
+  const double preferred = parameters_.preferred_clearance;
+  if (parameters_.clearance_cost <= 0.0 || preferred <= 0.0) return cost;
+  const double half_width = 0.5 * outline_.width();
+  const double centre_x = 0.5 * (outline_.min().x() + outline_.max().x());
+  const int pieces = std::max(1, static_cast<int>(std::ceil(length / 0.2)));
+  const Eigen::Vector2d centre_offset = centre_x * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+  for (int k = 0; k < pieces; ++k) {
+    const double f = (k + 0.5) / pieces;
+    const Eigen::Vector2d centre = Eigen::Vector2d(a.x + f * (b.x - a.x), a.y + f * (b.y - a.y)) + centre_offset;
+    const double clearance = map_.DistanceToObstacleAtCell(centre) - half_width;
+    cost += length / pieces * parameters_.clearance_cost * std::max(0.0, 1.0 - clearance / preferred);
+  }
+  return cost;
+}
+
+PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt) const {
   PlanResult result;
-  if (!Free(goal)) {
-    result.message = "goal is within " + std::to_string(parameters_.robot_radius) + " m of an obstacle in the map";
+  std::vector<double> goal_headings;
+  for (int k = 0; k < kHeadings; ++k) {
+    const double yaw = WrapAngle(2.0 * M_PI * k / kHeadings);
+    if (Valid({goal.x(), goal.y(), yaw})) goal_headings.push_back(yaw);
+  }
+  if (goal_headings.empty()) {
+    result.message = "the outline keeps " + std::to_string(parameters_.min_clearance) +
+                     " m from the obstacles at no heading at the goal";
     return result;
   }
-  // After a drift or a recovery the robot may believe it is inside the clearance: plan from the
-  // nearest free point and reach it first.
-  const Eigen::Vector2d planning_start = NearestFree(start, parameters_.start_escape_radius);
-  if (!Free(planning_start)) {
-    result.message = "start is inside an obstacle of the map and no free point is near";
-    return result;
+  // After a drift or a recovery the robot may believe its outline overlaps an obstacle: plan from
+  // the nearest pose that fits and go there first.
+  Pose2 planning_start = start;
+  if (Clearance(start, 0.0) < 0.0) {
+    const std::vector<Eigen::Vector2d> free =
+        StandablePositions({start.x, start.y}, parameters_.start_escape_radius, 1);
+    if (free.empty()) {
+      result.message = "the start overlaps an obstacle of the map and no pose within " +
+                       std::to_string(parameters_.start_escape_radius) + " m fits";
+      return result;
+    }
+    planning_start = {free.front().x(), free.front().y(), *FreeHeading(free.front())};
   }
 
-  auto space = std::make_shared<ob::RealVectorStateSpace>(2);
+  auto space = std::make_shared<ob::SE2StateSpace>();
   ob::RealVectorBounds bounds(2);
   bounds.setLow(0, map_.origin().x());
   bounds.setLow(1, map_.origin().y());
   bounds.setHigh(0, map_.origin().x() + map_.size().x());
   bounds.setHigh(1, map_.origin().y() + map_.size().y());
   space->setBounds(bounds);
-
   auto si = std::make_shared<ob::SpaceInformation>(space);
-  si->setStateValidityChecker([this](const ob::State* state) { return Free(Point(state)); });
-  si->setMotionValidator(std::make_shared<FootprintMotionValidator>(si, *this, planning_start));
+  const ClearanceRule rule(*this, planning_start);
+  si->setStateValidityChecker([this, &rule](const ob::State* state) {
+    const Pose2 p = ToPose(state);
+    const double wanted = rule.At({p.x, p.y});
+    return Clearance(p, wanted) >= wanted;
+  });
+  si->setMotionValidator(std::make_shared<DriveMotionValidator>(si, *this, rule));
   si->setup();
 
-  // RRT* joins the goal only from its nearest tree node: a goal that some headings cannot arrive
-  // at (the footprint along the last segment) failed a third of the attempts when that node lay on
-  // such a side. Then plan to a point near the goal from which the last segment is valid instead.
-  const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
-  const double resolution = map_.resolution(), range = parameters_.range;
-  std::optional<std::vector<Eigen::Vector2d>> path =
-      RrtStar(si, planning_start, goal, resolution, range, iterations, &result.message);
-  for (int k = 0; k < 16 && !path; ++k) {
-    const double angle = 2.0 * M_PI * k / 16.0;
-    const Eigen::Vector2d before = goal + kGoalApproach * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    if (!Free(before) || !Motion(si, before, goal)) continue;
-    path = RrtStar(si, planning_start, before, resolution, range, iterations, nullptr);
-    if (path) path->push_back(goal);
+  ob::ScopedState<ob::SE2StateSpace> from(space);
+  SetPose(planning_start, from.get());
+  auto problem = std::make_shared<ob::ProblemDefinition>(si);
+  problem->addStartState(from);
+  // The goal poses: the goal position at every heading the outline fits at, and for each such
+  // heading an approach pose behind it, from which the robot drives straight in. A pose tight
+  // between obstacles can otherwise be entered only from a tree node in the narrow cone in line
+  // with it; an approach pose is entered from any node that can turn there. It is a base length
+  // behind the goal; on a retry (attempt > 0), the first pose further back, up to 4 m, where the
+  // base can turn all the way round (a goal beside a wall is reached by a run along the wall).
+  auto goals = std::make_shared<ob::GoalStates>(si);
+  goals->setThreshold(tolerance);
+  std::vector<Pose2> approaches;
+  const double step = map_.resolution();
+  for (const double yaw : goal_headings) {
+    const Pose2 at{goal.x(), goal.y(), yaw};
+    ob::ScopedState<ob::SE2StateSpace> state(space);
+    SetPose(at, state.get());
+    goals->addState(state);
+    const Eigen::Vector2d back(-std::cos(yaw), -std::sin(yaw));
+    const auto behind = [&](double distance) {
+      return Pose2{goal.x() + distance * back.x(), goal.y() + distance * back.y(), yaw};
+    };
+    std::vector<Pose2> candidates;
+    if (Valid(behind(outline_.length())) && MotionClear(*this, rule, behind(outline_.length()), at)) {
+      candidates.push_back(behind(outline_.length()));
+    }
+    for (double d = 2.0 * step; attempt > 0 && d <= 4.0; d += 2.0 * step) {
+      const Pose2 p = behind(d);
+      if (!Valid(p) || !MotionClear(*this, rule, p, behind(d - 2.0 * step))) break;  // the run is blocked
+      const double wanted = parameters_.min_clearance;
+      if (d > outline_.length() && outline_.TurnClearance(map_, p, yaw + 3.1, step, wanted) >= wanted &&
+          outline_.TurnClearance(map_, p, yaw - 3.1, step, wanted) >= wanted) {
+        candidates.push_back(p);
+        break;
+      }
+    }
+    for (const Pose2& approach : candidates) {
+      SetPose(approach, state.get());
+      goals->addState(state);
+      approaches.push_back(approach);
+    }
   }
-  if (!path) return result;
-  result.message.clear();
-  if (planning_start != start) result.path.push_back(start);
-  result.path.insert(result.path.end(), path->begin(), path->end());
+  problem->setGoal(goals);
+  auto objective = std::make_shared<DriveObjective>(si, *this);
+  problem->setOptimizationObjective(objective);
+  auto planner = std::make_shared<og::RRTstar>(si);
+  planner->setRange(parameters_.range);
+  planner->setKNearest(false);  // neighbours within the shrinking RRT* radius: fewer long edges to cost
+  planner->setProblemDefinition(problem);
+  planner->setup();
+  const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
+  ob::IterationTerminationCondition budget(iterations);
+  const ob::PlannerStatus status = planner->solve(budget);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    result.message = std::string("no path found (") + status.asString() + ", " +
+                     std::to_string(problem->getSolutionDifference()) + " m short)";
+    return result;
+  }
+  auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
+  // Only simplifications that join existing vertices: OMPL's shortcutting also joins points
+  // interpolated within a motion, assuming a part of a valid motion is valid - not so for
+  // turn-drive-turn motions (the interpolated pose's heading makes its own turn).
+  og::PathSimplifier simplifier(si, problem->getGoal(), objective);
+  for (bool changed = true; changed;) {
+    changed = simplifier.reduceVertices(path);
+    changed = simplifier.collapseCloseVertices(path) || changed;
+  }
+
+  std::vector<Pose2> poses;
+  for (const ob::State* state : path.getStates()) poses.push_back(ToPose(state));
+  // Ended on an approach pose: drive straight in.
+  for (const Pose2& approach : approaches) {
+    if (std::hypot(poses.back().x - approach.x, poses.back().y - approach.y) <= tolerance + 1e-9) {
+      poses.push_back({goal.x(), goal.y(), approach.yaw});
+      break;
+    }
+  }
+  // The follower turns at each vertex from the incoming to the outgoing direction; the motions
+  // checked turned through the vertex's own heading. Give the vertices their arrival headings and
+  // keep that if it is still clear (it nearly always is).
+  std::vector<Pose2> arriving = poses;
+  for (std::size_t i = 1; i < arriving.size(); ++i) {
+    const Pose2& p = arriving[i - 1];
+    if (std::hypot(arriving[i].x - p.x, arriving[i].y - p.y) > 1e-9) {
+      arriving[i].yaw = std::atan2(arriving[i].y - p.y, arriving[i].x - p.x);
+    }
+  }
+  bool arriving_clear = true;
+  for (std::size_t i = 1; i < arriving.size() && arriving_clear; ++i) {
+    arriving_clear = MotionClear(*this, rule, arriving[i - 1], arriving[i]);
+  }
+  if (arriving_clear) poses = arriving;
+
+  if (planning_start.x != start.x || planning_start.y != start.y) result.path.push_back({start.x, start.y});
+  for (const Pose2& p : poses) {
+    const Eigen::Vector2d point(p.x, p.y);
+    if (result.path.empty() || (point - result.path.back()).norm() > 1e-9) result.path.push_back(point);
+  }
+  if (result.path.size() < 2) result.path.push_back(result.path.back());
   for (std::size_t i = 1; i < result.path.size(); ++i) result.length += (result.path[i] - result.path[i - 1]).norm();
+  for (std::size_t i = 1; i < poses.size(); ++i) result.cost += MotionCost(poses[i - 1], poses[i]);
   result.found = true;
   return result;
 }

@@ -36,11 +36,21 @@ const char* ToString(NavigationEvent::Type type) {
   return "?";
 }
 
-Navigator::Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters)
+namespace {
+
+// A turn on the spot costs the planner what driving for the same time would.
+PlannerParameters WithTurnCost(PlannerParameters planner, const FollowerParameters& follower) {
+  planner.turn_cost = follower.cruise_speed / follower.max_angular_speed;
+  return planner;
+}
+
+}  // namespace
+
+Navigator::Navigator(const OccupancyGrid& map, const BaseOutline& outline, const NavigatorParameters& parameters)
     : map_(map),
       costmap_(map),
       parameters_(parameters),
-      planner_(costmap_, parameters.planner),
+      planner_(costmap_, outline, WithTurnCost(parameters.planner, parameters.follower)),
       follower_(parameters.follower) {}
 
 void Navigator::SetCostmap(OccupancyGrid costmap) {
@@ -63,19 +73,21 @@ std::optional<Eigen::Vector2d> Navigator::PathAheadBlocked(const Pose2& estimate
   const double length0 = (b0 - a0).squaredNorm();
   const double along0 = length0 > 0.0 ? std::clamp((robot - a0).dot(b0 - a0) / length0, 0.0, 1.0) : 0.0;
   const double step = 0.5 * costmap_.resolution();
+  const double wanted = parameters_.planner.min_clearance;
   double travelled = 0.0;
   Eigen::Vector2d from = a0 + along0 * (b0 - a0);
   for (std::size_t i = first + 1; i < path.size() && travelled <= parameters_.blocked_horizon; ++i) {
     const Eigen::Vector2d to = path[i];
     const double length = (to - from).norm();
+    const double heading = std::atan2(to.y() - from.y(), to.x() - from.x());
     const int steps = std::max(1, static_cast<int>(std::ceil(length / step)));
     for (int k = 0; k <= steps; ++k) {
       const Eigen::Vector2d q = from + (static_cast<double>(k) / steps) * (to - from);
       // Right around the robot the obstacle stop guards it; and only what perception added
       // counts: the plan already kept its clearance from the prior map.
-      if ((q - robot).norm() < parameters_.planner.start_footprint_free) continue;
-      if (costmap_.DistanceToObstacle(q) < parameters_.blocked_clearance &&
-          map_.DistanceToObstacle(q) >= parameters_.blocked_clearance) {
+      if ((q - robot).norm() < parameters_.planner.start_free_radius) continue;
+      const Pose2 pose{q.x(), q.y(), heading};
+      if (planner_.Clearance(pose, wanted) < wanted && planner_.outline().Clearance(map_, pose, wanted) >= wanted) {
         return q;
       }
     }
@@ -93,10 +105,6 @@ void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals, int first_in
   plan_failures_ = 0;
   follower_.SetPath({});
   mode_ = goals_.empty() ? Mode::kDone : Mode::kIdle;
-}
-
-double Navigator::FootprintClearance(const Pose2& pose) const {
-  return parameters_.planner.footprint.Clearance(costmap_, pose.x, pose.y, pose.yaw);
 }
 
 void Navigator::Emit(double stamp, NavigationEvent::Type type, const std::string& detail,
@@ -118,18 +126,26 @@ void Navigator::GiveUpGoal(double stamp, const std::string& why) {
 
 void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   const auto start = std::chrono::steady_clock::now();
-  Eigen::Vector2d goal = goals_[goal_];
-  if (!planner_.Free(goal)) {
-    // Inside an obstacle's clearance (of the map, or seen): the nearest point the robot can arrive
-    // at from any direction instead (its footprint may face the obstacle there).
-    const auto nearest =
-        planner_.NearestWithClearance(goal, planner_.ArrivalClearance(), parameters_.goal_search_radius);
-    if (nearest) {
-      Emit(stamp, NavigationEvent::Type::kGoalAdjusted, std::to_string((*nearest - goal).norm()) + " m", *nearest);
-      goal = *nearest;
+  const Eigen::Vector2d asked = goals_[goal_];
+  if (plan_failures_ == 0) {
+    // Where the outline fits, nearest first (the goal itself if it fits there): each failed plan
+    // tries the next, since a pose that fits may not be reachable (no room to turn into it).
+    goal_candidates_ =
+        planner_.StandablePositions(asked, parameters_.goal_search_radius, parameters_.max_plan_failures);
+    if (goal_candidates_.empty()) {
+      GiveUpGoal(stamp, "the base's outline fits nowhere within " + std::to_string(parameters_.goal_search_radius) +
+                            " m of the goal (keeping " + std::to_string(parameters_.planner.min_clearance) +
+                            " m from the obstacles)");
+      return;
     }
   }
-  const PlanResult plan = planner_.Plan({estimate.x, estimate.y}, goal, plan_failures_);
+  const Eigen::Vector2d goal =
+      goal_candidates_[std::min(static_cast<std::size_t>(plan_failures_), goal_candidates_.size() - 1)];
+  if (goal != asked) {
+    Emit(stamp, NavigationEvent::Type::kGoalAdjusted, std::to_string((goal - asked).norm()) + " m", goal);
+  }
+  // To the goal's position within half a cell, any heading.
+  const PlanResult plan = planner_.Plan(estimate, goal, 0.5 * costmap_.resolution(), plan_failures_);
   active_goal_ = goal;
   planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
@@ -145,7 +161,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
 std::string Navigator::DescribeBlock(const Eigen::Vector2d& blocked) const {
   // The seen obstacle cell nearest to the blocked point, for the log.
   const cv::Point centre = costmap_.Cell(blocked);
-  const int reach = static_cast<int>(std::ceil(parameters_.blocked_clearance / costmap_.resolution()));
+  const int reach = static_cast<int>(std::ceil(planner_.outline().reach() / costmap_.resolution())) + 1;
   double nearest = std::numeric_limits<double>::infinity();
   Eigen::Vector2d seen = blocked;
   for (int dr = -reach; dr <= reach; ++dr) {
@@ -177,9 +193,9 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   }
 
   if (mode_ == Mode::kBackingOff) {
-    // Straight back until the footprint is clear again (or the back-off distance is used up).
+    // Straight back until the outline is clear again (or the back-off distance is used up).
     const double moved = (Eigen::Vector2d(estimate.x, estimate.y) - backoff_start_).norm();
-    if (FootprintClearance(estimate) >= parameters_.resume_clearance || moved >= parameters_.max_backoff) {
+    if (OutlineClearance(estimate, parameters_.resume_clearance) >= parameters_.resume_clearance || moved >= parameters_.max_backoff) {
       Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
       mode_ = Mode::kIdle;
       return stop;  // plan on the next update, from where the robot stopped
@@ -201,12 +217,12 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
     return stop;
   }
   // Too close to an obstacle while moving towards it - driving forward, or turning on the spot,
-  // which sweeps the footprint's front round (checked turn_check_angle ahead): stop and back off.
+  // which sweeps the outline's front round (checked turn_check_angle ahead): stop and back off.
   const bool turning_in_place = follow.command.linear == 0.0 && follow.command.angular != 0.0;
   Pose2 turned = estimate;
   turned.yaw += std::copysign(parameters_.turn_check_angle, follow.command.angular);
-  const bool too_close = (follow.command.linear > 0.0 && FootprintClearance(estimate) < parameters_.stop_clearance) ||
-                         (turning_in_place && FootprintClearance(turned) < parameters_.stop_clearance);
+  const bool too_close = (follow.command.linear > 0.0 && OutlineClearance(estimate, parameters_.stop_clearance) < parameters_.stop_clearance) ||
+                         (turning_in_place && OutlineClearance(turned, parameters_.stop_clearance) < parameters_.stop_clearance);
   if (too_close) {
     Emit(stamp, NavigationEvent::Type::kObstacleStop, turning_in_place ? "turning" : "driving");
     if (++recoveries_ > parameters_.max_recoveries_per_goal) {

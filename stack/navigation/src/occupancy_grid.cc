@@ -68,6 +68,13 @@ Eigen::Vector2d OccupancyGrid::CellCentre(const cv::Point& cell) const {
   return origin_ + resolution_ * Eigen::Vector2d(cell.x + 0.5, occupied_.rows - 1 - cell.y + 0.5);
 }
 
+double OccupancyGrid::DistanceToObstacleAtCell(const Eigen::Vector2d& point) const {
+  const Eigen::Vector2d local = (point - origin_) / resolution_;
+  const int column = static_cast<int>(std::floor(local.x())), y = static_cast<int>(std::floor(local.y()));
+  if (column < 0 || y < 0 || column >= distance_.cols || y >= distance_.rows) return 0.0;
+  return static_cast<double>(distance_.at<float>(distance_.rows - 1 - y, column));
+}
+
 double OccupancyGrid::DistanceToObstacle(const Eigen::Vector2d& point) const {
   if (!Contains(point)) return 0.0;
   // Bilinear interpolation between the four surrounding cell centres.

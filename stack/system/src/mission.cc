@@ -80,10 +80,9 @@ void Mission::SetArmGoals(const std::vector<Eigen::Isometry3d>& cutter_poses) {
 
 Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& from,
                                        const Navigator& navigator) const {
-  // Of the sides of the bush where the footprint at the standoff clears the map (other than the
-  // bush), the nearest to where the robot comes from whose approach point can be arrived at from
-  // any direction (RRT* reaches a goal only along an edge from its nearest node, so a goal some
-  // headings cannot arrive at makes it fail at random); failing that, one the planner accepts at all.
+  // Of the sides of the bush where the base's outline at the standoff clears the map (other than
+  // the bush), the nearest to where the robot comes from whose approach point the outline fits at
+  // facing the bush (the servo turns there to face it); failing that, one where it fits at all.
   const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
   const double reach = standoff + parameters_.bush_approach.approach_margin + arm_axis_.x();
   // Sides every 10 deg; a box only towards its corners (+-15 deg), where two faces show: seen
@@ -98,17 +97,17 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
   } else {
     for (int k = 0; k < 36; ++k) sides.push_back(2.0 * M_PI * k / 36.0);
   }
-  for (const double clearance : {navigator.ArrivalClearance(), parameters_.navigation.planner.robot_radius}) {
+  for (const bool facing_the_bush : {true, false}) {
     std::optional<Eigen::Vector2d> best;
     for (const double angle : sides) {
       const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
       const Eigen::Vector2d approach = goal.position + reach * side;
       const Eigen::Vector2d at_standoff = goal.position + (standoff + arm_axis_.x()) * side;
       const Pose2 facing{at_standoff.x(), at_standoff.y(), angle + M_PI};
-      if (navigator.costmap().DistanceToObstacle(approach) < clearance ||
-          navigator.FootprintClearance(facing) < 2.0 * parameters_.navigation.stop_clearance) {
-        continue;
-      }
+      const bool fits = facing_the_bush ? navigator.planner().Valid({approach.x(), approach.y(), angle + M_PI})
+                                        : navigator.planner().FreeHeading(approach).has_value();
+      const double wanted = 2.0 * parameters_.navigation.stop_clearance;
+      if (!fits || navigator.OutlineClearance(facing, wanted) < wanted) continue;
       if (!best || (approach - from).norm() < (*best - from).norm()) best = approach;
     }
     if (best) return *best;

@@ -55,12 +55,10 @@ void ObstacleDetectionComponent::Consume(const messages::RingFrame& frame, Stack
   next_frame_ = frame.stamp + 1.0 / parameters_.obstacles.rate_hz;
   const Eigen::Isometry3d T_map_base = ToIsometry(state->ekf.Estimate().pose);
   perception::ObstaclePointOptions options = parameters_.obstacles.points;
-  // The robot's own body (base, ring, arm at rest) is the footprint's box with a margin.
-  const Footprint& footprint = parameters_.navigation.planner.footprint;
-  const auto [lowest, highest] = std::minmax_element(footprint.circle_x.begin(), footprint.circle_x.end());
+  // The robot's own body (base, ring, arm at rest) is the base's outline with a margin.
   const double margin = 0.05;
-  options.robot_min = {*lowest - footprint.circle_radius - margin, -footprint.circle_radius - margin};
-  options.robot_max = {*highest + footprint.circle_radius + margin, footprint.circle_radius + margin};
+  options.robot_min = state->outline.min() - Eigen::Vector2d::Constant(margin);
+  options.robot_max = state->outline.max() + Eigen::Vector2d::Constant(margin);
   ObstacleObservation observation;
   observation.stamp = frame.stamp;
   observation.min_obstacle_height = options.min_height;

@@ -70,14 +70,12 @@ RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& pa
         "stack parameters: perception.obstacles.max_bearing_deg leaves no stereo pair "
         "facing forward");
   }
-  // The standoff must leave the footprint's front clear of the bush's surveyed outline.
-  const Footprint& footprint = parameters_.navigation.planner.footprint;
-  const double front = *std::max_element(footprint.circle_x.begin(), footprint.circle_x.end()) +
-                       footprint.circle_radius - components_->state.arm_axis.x();
+  // The standoff must leave the base's front clear of the bush's surveyed outline.
+  const double front = components_->state.outline.max().x() - components_->state.arm_axis.x();
   if (parameters_.bush_approach.servo.surface_gap < front + parameters_.navigation.stop_clearance) {
     throw std::invalid_argument("stack parameters: bush_approach.servo.surface_gap must be at least " +
                                 std::to_string(front + parameters_.navigation.stop_clearance) +
-                                " m (the footprint's front from the arm's axis, plus navigation.stop_clearance)");
+                                " m (the base's front from the arm's axis, plus navigation.stop_clearance)");
   }
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
@@ -101,7 +99,7 @@ void RobotStack::SetMap(const std::string& map_yaml) {
   StackState& state = components_->state;
   state.navigator.reset();
   state.map = std::make_unique<OccupancyGrid>(OccupancyGrid::LoadMapServer(map_yaml));
-  state.navigator = std::make_unique<Navigator>(*state.map, parameters_.navigation);
+  state.navigator = std::make_unique<Navigator>(*state.map, state.outline, parameters_.navigation);
   components_->obstacles.SetMap(*state.map);
 }
 

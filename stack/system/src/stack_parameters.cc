@@ -92,21 +92,11 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
   if (p.latency_max < p.latency_median) r.map().Fail("latency_max", "must be at least latency_median");
 }
 
-void ReadFootprint(Reader& r, Footprint& p) {
-  if (r.Wanted("circle_x")) {
-    p.circle_x = r.map().Doubles("circle_x");
-    if (p.circle_x.empty()) r.map().Fail("circle_x", "needs at least one circle");
-    for (double x : p.circle_x) {
-      if (std::abs(x) > 5.0) r.map().Fail("circle_x", "values must be finite and within 5 m");
-    }
-  }
-  r.Number("circle_radius", &p.circle_radius, 0.01, 5.0, "m");
-}
-
 void ReadPlanner(Reader& r, PlannerParameters& p) {
-  r.Number("robot_radius", &p.robot_radius, 0.0, 5.0, "m");
-  r.Number("footprint_margin", &p.footprint_margin, 0.0, 2.0, "m");
-  r.Number("start_footprint_free", &p.start_footprint_free, 0.0, 5.0, "m");
+  r.Number("min_clearance", &p.min_clearance, 0.0, 2.0, "m");
+  r.Number("preferred_clearance", &p.preferred_clearance, 0.0, 5.0, "m");
+  r.Number("clearance_cost", &p.clearance_cost, 0.0, 100.0, "m per m");
+  r.Number("start_free_radius", &p.start_free_radius, 0.0, 5.0, "m");
   r.Integer("iterations", &p.iterations, 10, 10000000);
   r.Number("range", &p.range, 0.05, 100.0, "m");
   r.Number("start_escape_radius", &p.start_escape_radius, 0.0, 10.0, "m");
@@ -129,7 +119,6 @@ void ReadFollower(Reader& r, FollowerParameters& p) {
 void ReadNavigation(Reader& r, StackParameters& s) {
   NavigatorParameters& p = s.navigation;
   r.Number("control_rate_hz", &s.control_rate_hz, 1.0, 400.0, "Hz");
-  r.Section("footprint", [&](Reader& f) { ReadFootprint(f, p.planner.footprint); });
   r.Section("planner", [&](Reader& f) { ReadPlanner(f, p.planner); });
   r.Section("follower", [&](Reader& f) { ReadFollower(f, p.follower); });
   r.Number("stop_clearance", &p.stop_clearance, -1.0, 2.0, "m");
@@ -141,11 +130,10 @@ void ReadNavigation(Reader& r, StackParameters& s) {
   r.Integer("max_recoveries_per_goal", &p.max_recoveries_per_goal, 0, 1000);
   r.Integer("max_plan_failures", &p.max_plan_failures, 1, 1000);
   r.Number("goal_search_radius", &p.goal_search_radius, 0.0, 2.0, "m");
-  r.Number("blocked_clearance", &p.blocked_clearance, 0.0, 5.0, "m");
   r.Number("blocked_horizon", &p.blocked_horizon, 0.0, 100.0, "m");
   if (p.resume_clearance < p.stop_clearance) r.map().Fail("resume_clearance", "must be at least stop_clearance");
-  if (p.blocked_clearance >= p.planner.robot_radius) {
-    r.map().Fail("blocked_clearance", "must be less than planner.robot_radius (every new path would be blocked)");
+  if (p.stop_clearance >= p.planner.min_clearance) {
+    r.map().Fail("stop_clearance", "must be less than planner.min_clearance (the robot would stop on its own paths)");
   }
   if (p.follower.min_speed > p.follower.cruise_speed) {
     r.map().Fail("follower", "min_speed must not exceed cruise_speed");

@@ -7,6 +7,7 @@ namespace trimbot::stack {
 StackState::StackState(const robot::RobotFiles& files, const StackParameters& parameters)
     : description(robot::RobotDescription::Load(files.urdf)),
       rig(robot::CameraRig::LoadKalibr(files.camchain, description.FramePose(robot::RobotFrames::CameraOptical(0)))),
+      outline(description.BaseOutline().first, description.BaseOutline().second),
       ticks_per_revolution(robot::RobotParameters::Load(files.robot_parameters).wheel_encoders.ticks_per_revolution),
       odometry(description.drive(), ticks_per_revolution),
       servo_odometry(description.drive(), ticks_per_revolution),

@@ -10,6 +10,7 @@
 #include "trimbot/robot/camera_rig.h"
 #include "trimbot/robot/robot_description.h"
 #include "trimbot/robot/robot_files.h"
+#include "trimbot/stack/base_outline.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
 #include "trimbot/stack/occupancy_grid.h"
@@ -26,6 +27,7 @@ struct StackState {
 
   robot::RobotDescription description;
   robot::CameraRig rig;
+  BaseOutline outline;  // the base's, from the URDF's collision geometry
   int ticks_per_revolution = 0;
   WheelOdometry odometry;
   GyroOdometry servo_odometry;  // the bush servo's frame

@@ -1,45 +1,49 @@
 #pragma once
 // Global path planning with OMPL over the robot's costmap (the prior map and what perception has
-// seen): RRT* in the plane for base_link, keeping `robot_radius` from every occupied cell, and
-// along every path segment keeping the footprint - pointing along the segment, as the robot
-// drives it - `footprint_margin` clear; then shortcut-simplified. The planner runs for a fixed
-// number of iterations (not a time budget), so with OMPL's seed fixed (ompl::RNG::setSeed, once
-// per process) the same problem gives the same path on any machine.
+// seen), in SE(2) with the base's real outline (BaseOutline: the URDF's collision rectangle, exact
+// against the costmap's cells):
+// - states (x, y, yaw); a motion between two states is what the differential drive follows
+//   exactly: turn on the spot to face the second state, drive straight to it, turn on the spot to
+//   its heading. The outline is checked at every pose along it (straight: every half cell; turning:
+//   every half cell of its farthest corner's travel);
+// - the outline must keep `min_clearance` from every occupied cell (the wall); below
+//   `preferred_clearance` each metre driven costs up to `clearance_cost` metres more (clearance as
+//   a cost: a narrow passage is allowed, a wide one preferred); turning on the spot costs the
+//   driving the same time would (`turn_cost`, from the follower's speeds);
+// - a goal is a position with a tolerance and any heading (OMPL samples goal poses at the headings
+//   where the outline fits);
+// - RRT* for a fixed number of iterations (not a time budget), then shortcut-simplified: with OMPL's
+//   seed fixed (SeedPlanner, once per process) the same problem gives the same path on any machine.
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "trimbot/common/pose2.h"
+#include "trimbot/stack/base_outline.h"
 #include "trimbot/stack/occupancy_grid.h"
 
 namespace trimbot::stack {
 
-// The base footprint as circles along base_link's x axis (rectangle 0.70 x 0.51 m from x = -0.12).
-struct Footprint {
-  std::vector<double> circle_x = {0.02, 0.23, 0.44};  // m in base_link
-  double circle_radius = 0.27;                        // m
-
-  // Smallest distance from the footprint at (x, y, yaw) to an obstacle of the map (negative:
-  // overlap).
-  double Clearance(const OccupancyGrid& map, double x, double y, double yaw) const;
-};
-
 struct PlannerParameters {
-  Footprint footprint;
-  double robot_radius = 0.5;           // m: clearance from base_link to the map's obstacles
-  double footprint_margin = 0.1;       // m: clearance of the footprint driving along the path
-  double start_footprint_free = 0.25;  // m: near the start only base_link's clearance is checked (the
-                                       // robot turns on the spot there; the obstacle stop guards it)
-  int iterations = 3000;               // RRT* iterations per plan
-  double range = 1.5;                  // m: longest RRT* edge
-  double start_escape_radius = 1.0;    // m: a start inside the clearance is moved out by up to this
+  double min_clearance = 0.05;        // m: the outline's clearance from every occupied cell
+  double preferred_clearance = 0.4;   // m: less than this costs extra ...
+  double clearance_cost = 2.0;        // ... up to this many metres per metre driven at no clearance
+  double turn_cost = 0.4;             // m per rad turned on the spot (set from the follower's speeds)
+  double start_free_radius = 0.25;    // m: near the start the outline need only get no closer to an
+                                      // obstacle than it starts (after a stop it may be within min_clearance)
+  double start_escape_radius = 1.0;   // m: a start whose outline overlaps is moved out by up to this
+  int iterations = 3000;              // RRT* iterations per plan
+  double range = 1.5;                 // m: longest RRT* edge
 };
 
 struct PlanResult {
   bool found = false;
   std::vector<Eigen::Vector2d> path;  // map frame, from the start to the goal
   double length = 0.0;                // m
+  double cost = 0.0;                  // m: length plus the turns' and the clearance's costs
   std::string message;                // why no path was found
 };
 
@@ -49,28 +53,33 @@ void SeedPlanner(std::uint64_t seed);
 
 class GlobalPlanner {
  public:
-  GlobalPlanner(const OccupancyGrid& map, const PlannerParameters& parameters);
+  GlobalPlanner(const OccupancyGrid& map, const BaseOutline& outline, const PlannerParameters& parameters);
 
-  // `attempt` k > 0 (a retry after a failed plan) runs 2^k times the iterations: narrow approaches
-  // to a goal among bushes may need a denser tree.
-  PlanResult Plan(const Eigen::Vector2d& start, const Eigen::Vector2d& goal, int attempt = 0) const;
-  // base_link may be at `point` (the clearance holds).
-  bool Free(const Eigen::Vector2d& point) const;
-  // The free point nearest to `point` within `radius`, or `point` itself if none is free.
-  Eigen::Vector2d NearestFree(const Eigen::Vector2d& point, double radius) const;
-  // Clearance at which the robot can arrive from any direction: the footprint's reach from
-  // base_link plus footprint_margin (the footprint may face the obstacle on arrival).
-  double ArrivalClearance() const;
-  // The point nearest to `point` within `radius` that keeps `clearance` from every obstacle, or
-  // nullopt if there is none.
-  std::optional<Eigen::Vector2d> NearestWithClearance(const Eigen::Vector2d& point, double clearance,
-                                                      double radius) const;
+  // A path from `start` to a pose whose position is within `tolerance` of `goal` (any heading).
+  // `attempt` k > 0 (a retry after a failed plan) runs 2^k times the iterations.
+  PlanResult Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt = 0) const;
+
+  // The outline's clearance at `pose` (BaseOutline::Clearance on the map).
+  double Clearance(const Pose2& pose, double enough = std::numeric_limits<double>::infinity()) const;
+  // The outline at `pose` keeps min_clearance.
+  bool Valid(const Pose2& pose) const;
+  // Of 32 headings at `position`, the one with the most clearance if it keeps min_clearance.
+  std::optional<double> FreeHeading(const Eigen::Vector2d& position) const;
+  // Up to `count` positions within `radius` of `point` where some heading keeps min_clearance,
+  // nearest first (rings a cell apart, points about a cell apart on each; `point` itself first if
+  // the outline fits there). A pose that fits may still not be reachable (a turn on the spot there
+  // may not fit): the navigator tries them in turn.
+  std::vector<Eigen::Vector2d> StandablePositions(const Eigen::Vector2d& point, double radius, int count) const;
+  // The cost of the motion a -> b (turn, straight, turn), in metres.
+  double MotionCost(const Pose2& a, const Pose2& b) const;
 
   const OccupancyGrid& map() const { return map_; }
+  const BaseOutline& outline() const { return outline_; }
   const PlannerParameters& parameters() const { return parameters_; }
 
  private:
   const OccupancyGrid& map_;
+  BaseOutline outline_;
   PlannerParameters parameters_;
 };
 

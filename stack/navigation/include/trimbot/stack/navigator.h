@@ -2,12 +2,14 @@
 // Goal-to-goal navigation on the pose estimate: plan over the costmap (the prior map plus the
 // obstacles perception has seen, SetCostmap), follow the path, plan again when what is seen
 // blocks it, and when the robot (by its estimate) gets too close to an obstacle, stop, back off
-// and plan again - the recovery behaviour of the real robot's navigation. A goal inside an
-// obstacle's clearance (robot_radius) is moved to the nearest point the robot can arrive at from
-// any direction (GlobalPlanner::ArrivalClearance), within goal_search_radius (reported). A system with explicit input
+// and plan again - the recovery behaviour of the real robot's navigation. Every check is of the
+// base's real outline (BaseOutline). A goal where the outline fits at no heading is moved to the
+// nearest position where it fits, within goal_search_radius (reported), and given up with the
+// reason when there is none. A system with explicit input
 // (time, pose estimate), output (base velocity command) and state (goal, path, mode); the events it
 // reports (goal reached, replans, recoveries, failures) go to the evaluation.
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,9 +23,9 @@
 namespace trimbot::stack {
 
 struct NavigatorParameters {
-  PlannerParameters planner;  // holds the footprint
+  PlannerParameters planner;
   FollowerParameters follower;
-  double stop_clearance = 0.03;   // m: footprint this close to the map's obstacles -> stop
+  double stop_clearance = 0.03;   // m: the outline this close to the costmap's obstacles -> stop
   double turn_check_angle = 0.3;  // rad: a turn on the spot is checked this far ahead
   double resume_clearance = 0.2;  // m: back off until this much is free again
   double backoff_speed = 0.1;     // m/s
@@ -31,11 +33,10 @@ struct NavigatorParameters {
   double replan_deviation = 0.6;  // m off the path -> plan again
   int max_recoveries_per_goal = 5;
   int max_plan_failures = 3;        // per goal, then the goal is given up
-  double goal_search_radius = 0.6;  // m: a goal in an obstacle's clearance moves at most this far
-  double blocked_clearance = 0.35;  // m: base_link's clearance from a seen obstacle along the path
-                                    // ahead below which it counts as blocked (< robot_radius, which
-                                    // the planner keeps)
-  double blocked_horizon = 4.0;     // m of path ahead checked when the costmap changes
+  double goal_search_radius = 0.6;  // m: a goal where the outline fits nowhere moves at most this far
+  double blocked_horizon = 4.0;     // m of path ahead checked when the costmap changes: where the
+                                    // outline, driving it, comes within planner.min_clearance of a
+                                    // seen obstacle, the path is blocked
 };
 
 struct NavigationEvent {
@@ -64,7 +65,8 @@ class Navigator {
  public:
   enum class Mode { kIdle, kFollowing, kBackingOff, kDone, kFailed };
 
-  Navigator(const OccupancyGrid& map, const NavigatorParameters& parameters);
+  // `outline`: the base's (RobotDescription::BaseOutline).
+  Navigator(const OccupancyGrid& map, const BaseOutline& outline, const NavigatorParameters& parameters);
   // The planner refers to this navigator's costmap: not copied or moved.
   Navigator(const Navigator&) = delete;
   Navigator& operator=(const Navigator&) = delete;
@@ -77,10 +79,13 @@ class Navigator {
   void SetCostmap(OccupancyGrid costmap);
   messages::BaseVelocityCommand Update(double stamp, const Pose2& estimate);
 
-  // Smallest distance from the footprint at `pose` to an obstacle of the costmap (negative: overlap).
-  double FootprintClearance(const Pose2& pose) const;
-  // m: a goal with this much clearance can be arrived at from any direction (GlobalPlanner).
-  double ArrivalClearance() const { return planner_.ArrivalClearance(); }
+  // Smallest distance from the outline at `pose` to an obstacle of the costmap (negative: overlap).
+  // Clearances beyond `enough` may be reported as any value >= `enough`.
+  double OutlineClearance(const Pose2& pose, double enough = std::numeric_limits<double>::infinity()) const {
+    return planner_.Clearance(pose, enough);
+  }
+  // The planner on the costmap (its outline checks, standable positions).
+  const GlobalPlanner& planner() const { return planner_; }
 
   Mode mode() const { return mode_; }
   int current_goal() const { return first_index_ + goal_; }
@@ -96,8 +101,8 @@ class Navigator {
   void GiveUpGoal(double stamp, const std::string& why);
   void Emit(double stamp, NavigationEvent::Type type, const std::string& detail = {},
             const Eigen::Vector2d& position = Eigen::Vector2d::Zero());
-  // The first point of the path ahead where base_link would come closer than blocked_clearance
-  // to an obstacle perception added to the prior map; nullopt if none.
+  // The first point of the path ahead where the outline, driving it, would come within the
+  // planner's min_clearance of an obstacle perception added to the prior map; nullopt if none.
   std::optional<Eigen::Vector2d> PathAheadBlocked(const Pose2& estimate) const;
   // "at (x y), seen obstacle at (x y)": the blocked point and the nearest cell perception added.
   std::string DescribeBlock(const Eigen::Vector2d& blocked) const;
@@ -118,6 +123,7 @@ class Navigator {
   double planning_seconds_ = 0.0;
   bool costmap_changed_ = false;
   Eigen::Vector2d active_goal_ = Eigen::Vector2d::Zero();  // the goal of the current plan
+  std::vector<Eigen::Vector2d> goal_candidates_;           // where the outline fits near the goal
 };
 
 }  // namespace trimbot::stack

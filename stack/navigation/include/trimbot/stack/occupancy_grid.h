@@ -18,6 +18,8 @@ class OccupancyGrid {
   // Distance in metres from a map point to the nearest occupied cell (0 inside one, and outside
   // the map), interpolated between cell centres.
   double DistanceToObstacle(const Eigen::Vector2d& point) const;
+  // The same at the centre of the point's cell: no interpolation, for costs evaluated very often.
+  double DistanceToObstacleAtCell(const Eigen::Vector2d& point) const;
   bool Contains(const Eigen::Vector2d& point) const;
 
   // Cell (column, row) holding a map point, and the map point at a cell's centre.
