@@ -106,8 +106,11 @@ TEST(BaseOutline, AgreesWithFclNearABoxAndACylinder) {
       EXPECT_NEAR(clearance, fcl_clearance, 1e-6) << "pose " << pose.x << ", " << pose.y << ", " << pose.yaw;
       // With a margin the answer is the same verdict, and exact below it.
       const double bounded = kOutline.Clearance(grid, pose, 0.1);
-      if (fcl_clearance < 0.1) EXPECT_NEAR(bounded, fcl_clearance, 1e-6);
-      if (fcl_clearance >= 0.1) EXPECT_GE(bounded, 0.1 - 1e-9);
+      if (fcl_clearance < 0.1) {
+        EXPECT_NEAR(bounded, fcl_clearance, 1e-6);
+      } else {
+        EXPECT_GE(bounded, 0.1 - 1e-9);
+      }
     }
   }
   std::printf("%d colliding and %d clear poses; largest difference from FCL on the clear ones %.2e m\n", collisions,

@@ -278,7 +278,11 @@ TEST(Navigator, GoalNearAnObstacleIsReachedWhereTheOutlineFits) {
   ASSERT_EQ(mode, Navigator::Mode::kDone);
   const Eigen::Vector2d used = adjusted_to(events).value_or(beside);
   EXPECT_LT((used - beside).norm(), 0.1);
-  EXPECT_LT(std::hypot(end.x - used.x(), end.y - used.y()), 0.1);
+  // Arrival is judged within the follower's goal_tolerance of the path's end, which is within half
+  // a cell of the goal planned to; the last step of 0.05 s may carry it 1.25 cm further.
+  const double arrival =
+      parameters.follower.goal_tolerance + 0.5 * map.resolution() + 0.05 * parameters.follower.cruise_speed;
+  EXPECT_LE(std::hypot(end.x - used.x(), end.y - used.y()), arrival);
   EXPECT_GE(kOutline.Clearance(map, end), 0.0);
 
   const Eigen::Vector2d in_the_wall(5.0, 3.0);

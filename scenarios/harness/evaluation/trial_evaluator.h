@@ -74,7 +74,7 @@ class TrialEvaluator : public Observer {
   std::vector<GoalResult> goals_;
   std::vector<std::optional<stack::BushApproachStatus>> bush_status_;  // per goal: the latest seen
   std::vector<BushFrame> bush_frames_;
-  EstimateErrors ekf_{"ekf", {}, {}}, odometry_{"wheel_odometry", {}, {}}, fixes_{"pose_fixes", {}, {}};
+  EstimateErrors ekf_{"ekf", {}, {}, {}}, odometry_{"wheel_odometry", {}, {}, {}}, fixes_{"pose_fixes", {}, {}, {}};
   std::string truth_tum_, ekf_tum_, odometry_tum_, fixes_tum_;
   LocalizationLog localization_log_;  // the stack's own visual localization, frame by frame
   std::string events_csv_ = "t,event,goal,detail\n";

@@ -33,7 +33,7 @@ double WrapAngle(double angle) { return std::remainder(angle, 2.0 * M_PI); }
 }  // namespace
 
 BaseOutline::BaseOutline(const Eigen::Vector2d& min, const Eigen::Vector2d& max) : min_(min), max_(max) {
-  for (const Eigen::Vector2d corner :
+  for (const Eigen::Vector2d& corner :
        {min, max, Eigen::Vector2d(min.x(), max.y()), Eigen::Vector2d(max.x(), min.y())}) {
     reach_ = std::max(reach_, corner.norm());
   }

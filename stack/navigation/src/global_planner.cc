@@ -51,6 +51,9 @@ class ClearanceRule {
     const double at_start = planner.Clearance(start, planner.parameters().min_clearance);
     near_start_ = std::min(planner.parameters().min_clearance, at_start - 1e-3);
   }
+  // min_clearance everywhere (no start to be exempt near).
+  explicit ClearanceRule(const GlobalPlanner& planner)
+      : planner_(planner), start_(Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity())) {}
   double At(const Eigen::Vector2d& position) const {
     return (position - start_).norm() < planner_.parameters().start_free_radius ? near_start_
                                                                                 : planner_.parameters().min_clearance;
@@ -185,6 +188,28 @@ std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen:
   return best;
 }
 
+// Whether the drive can arrive at `position` going forwards: some heading where the outline fits
+// and either turns all the way round there or has a straight run of a base length behind it that
+// keeps min_clearance. A pose that fits only backing in (a base with its rear to a wall, no room
+// to turn) is not a goal the drive can reach.
+bool Enterable(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
+  const ClearanceRule rule(planner);
+  const double wanted = planner.parameters().min_clearance;
+  const double step = 0.5 * planner.map().resolution();
+  for (int k = 0; k < kHeadings; ++k) {
+    const Pose2 at{position.x(), position.y(), WrapAngle(2.0 * M_PI * k / kHeadings)};
+    if (!planner.Valid(at)) continue;
+    if (planner.outline().TurnClearance(planner.map(), at, at.yaw + 3.1, step, wanted) >= wanted &&
+        planner.outline().TurnClearance(planner.map(), at, at.yaw - 3.1, step, wanted) >= wanted) {
+      return true;
+    }
+    const double run = planner.outline().length();
+    const Pose2 behind{at.x - run * std::cos(at.yaw), at.y - run * std::sin(at.yaw), at.yaw};
+    if (planner.Valid(behind) && MotionClear(planner, rule, behind, at)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::optional<double> GlobalPlanner::FreeHeading(const Eigen::Vector2d& position) const {
@@ -197,7 +222,7 @@ std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vect
                                                                 int count) const {
   std::vector<Eigen::Vector2d> positions;
   if (count <= 0) return positions;
-  if (FreeHeading(point)) positions.push_back(point);
+  if (FreeHeading(point) && Enterable(*this, point)) positions.push_back(point);
   const double step = map_.resolution();
   for (double r = step; r <= radius + 1e-9 && static_cast<int>(positions.size()) < count; r += step) {
     // Within a ring, the roomiest first: where the outline has more clearance it can also turn.
@@ -211,7 +236,7 @@ std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vect
     }
     std::stable_sort(ring.begin(), ring.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
     for (const auto& [clearance, candidate] : ring) {
-      if (static_cast<int>(positions.size()) < count) positions.push_back(candidate);
+      if (static_cast<int>(positions.size()) < count && Enterable(*this, candidate)) positions.push_back(candidate);
     }
   }
   return positions;

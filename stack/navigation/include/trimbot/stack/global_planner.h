@@ -65,10 +65,11 @@ class GlobalPlanner {
   bool Valid(const Pose2& pose) const;
   // Of 32 headings at `position`, the one with the most clearance if it keeps min_clearance.
   std::optional<double> FreeHeading(const Eigen::Vector2d& position) const;
-  // Up to `count` positions within `radius` of `point` where some heading keeps min_clearance,
-  // nearest first (rings a cell apart, points about a cell apart on each; `point` itself first if
-  // the outline fits there). A pose that fits may still not be reachable (a turn on the spot there
-  // may not fit): the navigator tries them in turn.
+  // Up to `count` positions within `radius` of `point` that the drive can enter going forwards
+  // (some heading keeps min_clearance there and either turns round there or has a straight run of
+  // a base length behind it), nearest first (rings a cell apart, points about a cell apart on each;
+  // `point` itself first if it qualifies). Such a position may still be unreachable from the start
+  // (the run behind it may lead nowhere): the navigator tries them in turn.
   std::vector<Eigen::Vector2d> StandablePositions(const Eigen::Vector2d& point, double radius, int count) const;
   // The cost of the motion a -> b (turn, straight, turn), in metres.
   double MotionCost(const Pose2& a, const Pose2& b) const;
