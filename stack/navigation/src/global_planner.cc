@@ -388,6 +388,20 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
       break;
     }
   }
+  // RRT* stops after a fixed number of iterations, often on a detour (round a bush instead of
+  // along the open lane beside it), and reduceVertices joins random pairs. Greedy shortcutting
+  // from each vertex to the farthest one it reaches directly, when that motion is clear and
+  // cheaper than the vertices between, removes the detours deterministically.
+  for (std::size_t i = 0; i + 2 < poses.size(); ++i) {
+    for (std::size_t j = poses.size() - 1; j > i + 1; --j) {
+      double via = 0.0;
+      for (std::size_t k = i + 1; k <= j; ++k) via += MotionCost(poses[k - 1], poses[k]);
+      if (MotionCost(poses[i], poses[j]) < via && MotionClear(*this, rule, poses[i], poses[j])) {
+        poses.erase(poses.begin() + static_cast<std::ptrdiff_t>(i) + 1, poses.begin() + static_cast<std::ptrdiff_t>(j));
+        break;
+      }
+    }
+  }
   // The follower turns at each vertex from the incoming to the outgoing direction; the motions
   // checked turned through the vertex's own heading. Give the vertices their arrival headings and
   // keep that if it is still clear (it nearly always is).
