@@ -12,7 +12,7 @@ PACKAGES=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev libopencv-features2d-dev
   libopencv-flann-dev
   liborocos-kdl-dev libfcl-dev liboctomap-dev
-  libompl-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
+  libompl-dev libboost-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
   clang clang-format libclang-rt-dev
   slurmctld slurmd slurm-client munge

@@ -145,7 +145,7 @@ Garden ImportGardenUiCsv(const std::string& path, double ground_z) {
 
 namespace {
 
-// Draws a garden's layout from one random stream in a fixed order (paths, trees, hedges, topiary,
+// Draws a garden's layout from one random stream in a fixed order (paths, trees, hedges, corridors, topiary,
 // roses, obstacles, fence), so the same seed gives the same garden.
 class GardenGenerator {
  public:
@@ -191,6 +191,7 @@ class GardenGenerator {
                  UniformUnit(rng_) < 0.5 ? 0.0 : M_PI / 2),
             p_.robot_clearance);
     }
+    for (int i = 0; i < p_.corridors; ++i) AddCorridor();
     for (int i = 0; i < p_.topiary; ++i) {
       const double d = uniform(0.6, 0.9);
       Place(Make(ObjectClass::kTopiary, UniformUnit(rng_) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
@@ -205,6 +206,27 @@ class GardenGenerator {
       Place(Make(ObjectClass::kObstacle, Shape::kBox, {uniform(0.3, 1.2), uniform(0.3, 1.0), uniform(0.3, 0.9)},
                  uniform(0.0, M_PI)),
             p_.robot_clearance);
+    }
+  }
+
+  // Two parallel hedges and the corridor between them, placed as one block (so nothing else is put
+  // inside the corridor), then split into the two hedges.
+  void AddCorridor() {
+    const double length = uniform(2.5, 4.5), thickness = uniform(0.5, 0.7), height = uniform(0.8, 1.4);
+    const double gap = uniform(p_.corridor_width.x(), p_.corridor_width.y());
+    const double yaw = UniformUnit(rng_) < 0.5 ? 0.0 : M_PI / 2;
+    GardenObject block = Make(ObjectClass::kHedge, Shape::kBox, {length, 2.0 * thickness + gap, height}, yaw);
+    GardenObject* placed = Place(block, p_.robot_clearance);
+    if (placed == nullptr) return;
+    const Eigen::Vector2d centre = placed->position;
+    const Eigen::Vector2d across(-std::sin(yaw), std::cos(yaw));
+    garden_.objects.pop_back();
+    --next_id_;
+    for (const double side : {-1.0, 1.0}) {
+      GardenObject hedge = Make(ObjectClass::kHedge, Shape::kBox, {length, thickness, height}, yaw);
+      hedge.position = centre + side * 0.5 * (gap + thickness) * across;
+      hedge.id = next_id_++;
+      garden_.objects.push_back(hedge);
     }
   }
 

@@ -50,6 +50,9 @@ void AddGardenCommands(Commands& commands) {
   generate_cmd->add_option("--obstacles", g.obstacles, "number of other obstacles")->check(CLI::Range(0, 1000));
   generate_cmd->add_option("--paths", g.paths, "number of paths (gravel, pavement, soil in turn)")
       ->check(CLI::Range(0, 100));
+  generate_cmd
+      ->add_option("--corridors", g.corridors, "number of hedge corridors (two parallel hedges, 1.0-1.2 m apart)")
+      ->check(CLI::Range(0, 100));
   generate_cmd->add_option("--clearance", g.robot_clearance, "free space kept between objects (m)")
       ->check(CLI::Range(0.0, 10.0));
   generate_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");

@@ -206,7 +206,10 @@ void ReadPlant(const YamlMap& root, Scenario& s) {
   }
 }
 
-void ReadCriteria(const YamlMap& criteria, Scenario& s) {
+}  // namespace
+
+std::vector<PassCriterion> ReadPassCriteria(const YamlMap& criteria) {
+  std::vector<PassCriterion> read;
   for (const auto& entry : criteria.node()) {
     if (!entry.first.IsScalar()) criteria.Fail("criteria", "metric names must be plain names");
     const std::string metric = entry.first.as<std::string>();
@@ -218,10 +221,13 @@ void ReadCriteria(const YamlMap& criteria, Scenario& s) {
     criterion.comparison = bound.Has("min") ? ">=" : "<=";
     criterion.threshold = bound.Has("min") ? bound.Number("min", -1e12, 1e12) : bound.Number("max", -1e12, 1e12);
     bound.RejectUnknownKeys();
-    s.criteria.push_back(criterion);
+    read.push_back(criterion);
   }
   criteria.RejectUnknownKeys();
+  return read;
 }
+
+namespace {
 
 RobotReference ReadRobotReference(const YamlMap& map) {
   RobotReference reference;
@@ -297,7 +303,7 @@ Scenario Scenario::Load(const std::string& path, const std::vector<Override>& ov
   s.wall_time_limit = root.NumberOr("wall_time_limit", s.wall_time_limit, 1e-3, 1e7, "s");
   ReadPlant(root, s);
   if (root.Has("stack")) s.stack = root.Map("stack");
-  if (root.Has("criteria")) ReadCriteria(root.Map("criteria"), s);
+  if (root.Has("criteria")) s.criteria = ReadPassCriteria(root.Map("criteria"));
   if (root.Has("robot_reference")) s.robot_reference = ReadRobotReference(root.Map("robot_reference"));
   root.RejectUnknownKeys();
   return s;

@@ -139,5 +139,8 @@ struct Scenario {
 
 // Names a criterion may use.
 bool IsKnownMetric(const std::string& name);
+// A `criteria:` map (metric: {min: v} or {max: v}); InputError naming the file and key when a
+// metric is unknown or a bound is not exactly one of min or max.
+std::vector<PassCriterion> ReadPassCriteria(const YamlMap& criteria);
 
 }  // namespace trimbot::scenarios

@@ -155,14 +155,22 @@ std::string OneLine(const TrialResult& r) {
 struct BatchTiming {
   std::optional<RunTiming> summed;  // stages summed over the trials that wrote them
   json arm_planning;                // {plans, median, p90, max} in ms; null without arm plans
+  json navigation_planning;         // the same for the navigator's global plans
 };
+
+// Plans' wall-clock times (s) as milliseconds: count, median, 90th percentile, max.
+json PlanTimeStats(std::vector<double> seconds) {
+  std::sort(seconds.begin(), seconds.end());
+  const auto at = [&](double q) { return 1e3 * seconds[static_cast<size_t>(q * (seconds.size() - 1))]; };
+  return {{"plans", seconds.size()}, {"median", at(0.5)}, {"p90", at(0.9)}, {"max", at(1.0)}};
+}
 
 BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& results) {
   json trials = json::array();
   double total = 0.0;
   std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
   std::vector<RunTiming> runs;
-  std::vector<double> arm_plans;  // s, every arm plan of every trial
+  std::vector<double> arm_plans, navigation_plans;  // s, every plan of every trial
   for (const auto& r : results) {
     trials.push_back({{"index", r.index}, {"seed", r.seed}, {"wall_seconds", r.wall_seconds}});
     total += r.wall_seconds;
@@ -179,17 +187,18 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
       const auto plans = timing["arm_planning_seconds"].get<std::vector<double>>();
       arm_plans.insert(arm_plans.end(), plans.begin(), plans.end());
     }
+    if (timing.is_object() && timing.contains("navigation_planning_seconds")) {
+      const auto plans = timing["navigation_planning_seconds"].get<std::vector<double>>();
+      navigation_plans.insert(navigation_plans.end(), plans.begin(), plans.end());
+    }
     if (timing.is_object() && timing.contains("visual_localization")) {
       const auto trial_frames = LocalizationTimesFromJson(timing["visual_localization"]);
       frames.insert(frames.end(), trial_frames.begin(), trial_frames.end());
     }
   }
   json report{{"trials", trials}, {"mean_wall_seconds", results.empty() ? 0.0 : total / results.size()}};
-  if (!arm_plans.empty()) {
-    std::sort(arm_plans.begin(), arm_plans.end());
-    const auto at = [&](double q) { return 1e3 * arm_plans[static_cast<size_t>(q * (arm_plans.size() - 1))]; };
-    report["arm_planning_ms"] = {{"plans", arm_plans.size()}, {"median", at(0.5)}, {"p90", at(0.9)}, {"max", at(1.0)}};
-  }
+  if (!arm_plans.empty()) report["arm_planning_ms"] = PlanTimeStats(arm_plans);
+  if (!navigation_plans.empty()) report["navigation_planning_ms"] = PlanTimeStats(navigation_plans);
   if (!frames.empty()) {
     report["visual_localization"] = LocalizationTimeStats(frames);
     report["visual_localization"].erase("frames_ms");  // in the trials' files
@@ -199,6 +208,7 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   }
   BatchTiming timing;
   if (report.contains("arm_planning_ms")) timing.arm_planning = report["arm_planning_ms"];
+  if (report.contains("navigation_planning_ms")) timing.navigation_planning = report["navigation_planning_ms"];
   if (!runs.empty()) {
     timing.summed = Sum(runs);
     report["stages_summed_over_trials"] = ToJson(*timing.summed);
@@ -278,6 +288,12 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
         << c.actual << ")\n";
   }
   if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
+  if (!timing.navigation_planning.is_null()) {
+    const json& plans = timing.navigation_planning;
+    log << "navigation planning (wall clock, goal candidates included): median " << plans["median"].get<double>()
+        << " ms, 90th percentile " << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>()
+        << " ms over " << plans["plans"].get<int>() << " plans\n";
+  }
   if (!timing.arm_planning.is_null()) {
     const json& plans = timing.arm_planning;
     log << "arm planning (wall clock, IK included): median " << plans["median"].get<double>() << " ms, 90th percentile "

@@ -52,6 +52,7 @@ void WriteTiming(const std::string& dir, const RunTiming& run, const stack::Stac
                  const std::vector<double>& arm_planning_seconds) {
   nlohmann::json timing = ToJson(run);
   if (!arm_planning_seconds.empty()) timing["arm_planning_seconds"] = arm_planning_seconds;
+  if (!t.plans.empty()) timing["navigation_planning_seconds"] = t.plans;
   WriteRunTimingChart(dir + "/timing.png", "where the trial's time went", run);
   if (!t.visual_frames.empty()) {
     timing["visual_localization"] = LocalizationTimeStats(t.visual_frames);

@@ -10,6 +10,8 @@
 #include <ompl/geometric/planners/rrt/RRTstar.h>
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+#include <boost/graph/dijkstra_shortest_paths.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -210,6 +212,168 @@ bool Enterable(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
   return false;
 }
 
+double PathCost(const GlobalPlanner& planner, const std::vector<Pose2>& poses) {
+  double cost = 0.0;
+  for (std::size_t i = 1; i < poses.size(); ++i) cost += planner.MotionCost(poses[i - 1], poses[i]);
+  return cost;
+}
+
+// RRT* stops after a fixed number of iterations, often on a detour (round a bush instead of along
+// the open lane beside it, a zig-zag where a straight run would do). Shortcutting removes them:
+// first from each vertex to the farthest vertex it reaches directly; then between two points drawn
+// along the path (OMPL's seeded generator), each with the heading of its straight piece. A
+// turn-drive-turn motion's straight part is still valid when cut short at the same heading, so only
+// the new motion between the two points needs checking - unlike OMPL's own shortcutting, which
+// interpolates headings and would skip the turns. Kept only where the path's cost falls.
+void Shortcut(const GlobalPlanner& planner, const ClearanceRule& rule, std::vector<Pose2>* path) {
+  std::vector<Pose2>& poses = *path;
+  for (std::size_t i = 0; i + 2 < poses.size(); ++i) {
+    for (std::size_t j = poses.size() - 1; j > i + 1; --j) {
+      double via = 0.0;
+      for (std::size_t k = i + 1; k <= j; ++k) via += planner.MotionCost(poses[k - 1], poses[k]);
+      if (planner.MotionCost(poses[i], poses[j]) < via && MotionClear(planner, rule, poses[i], poses[j])) {
+        poses.erase(poses.begin() + static_cast<std::ptrdiff_t>(i) + 1, poses.begin() + static_cast<std::ptrdiff_t>(j));
+        break;
+      }
+    }
+  }
+  ompl::RNG rng;
+  const int attempts = 20 * static_cast<int>(poses.size());
+  for (int attempt = 0; attempt < attempts && poses.size() >= 3; ++attempt) {
+    // Two points on different straight pieces: piece i (from pose i to i + 1) at fraction a.
+    std::size_t i = static_cast<std::size_t>(rng.uniformInt(0, static_cast<int>(poses.size()) - 2));
+    std::size_t j = static_cast<std::size_t>(rng.uniformInt(0, static_cast<int>(poses.size()) - 2));
+    if (i == j) continue;
+    if (i > j) std::swap(i, j);
+    const auto on_piece = [&](std::size_t k, double f) {
+      const Pose2& a = poses[k];
+      const Pose2& b = poses[k + 1];
+      const double heading = std::hypot(b.x - a.x, b.y - a.y) > 1e-9 ? std::atan2(b.y - a.y, b.x - a.x) : a.yaw;
+      return Pose2{a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), heading};
+    };
+    const Pose2 p = on_piece(i, rng.uniform01()), q = on_piece(j, rng.uniform01());
+    std::vector<Pose2> candidate(poses.begin(), poses.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    candidate.push_back(p);
+    candidate.push_back(q);
+    candidate.insert(candidate.end(), poses.begin() + static_cast<std::ptrdiff_t>(j) + 1, poses.end());
+    if (PathCost(planner, candidate) < PathCost(planner, poses) - 1e-6 && MotionClear(planner, rule, p, q)) {
+      poses = std::move(candidate);
+    }
+  }
+}
+
+// The cheapest route for base_link over the map's cells (Dijkstra, Boost.Graph), where the outline
+// fits sideways (a cell's distance to the nearest obstacle less half the base's width keeps the
+// rule's clearance), each step costed as MotionCost costs clearance - then thinned to a vertex about
+// every 0.4 m and checked as the drive's motions with the whole outline. RRT* with a fixed number
+// of iterations can settle on the wrong side of a row of bushes, which no shortcutting undoes; this
+// route is the other candidate, and the cheaper valid one is kept. Empty when there is none.
+std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
+                             const Eigen::Vector2d& goal) {
+  const OccupancyGrid& map = planner.map();
+  const PlannerParameters& parameters = planner.parameters();
+  const int rows = map.occupied().rows, cols = map.occupied().cols;
+  const double half_width = 0.5 * planner.outline().width();
+  const auto index = [cols](int r, int c) { return r * cols + c; };
+  const cv::Point from = map.Cell({start.x, start.y}), to = map.Cell(goal);
+  const auto inside = [&](const cv::Point& p) { return p.x >= 0 && p.y >= 0 && p.x < cols && p.y < rows; };
+  if (!inside(from) || !inside(to)) return {};
+  // Near the start (after a stop the robot may stand closer than min_clearance) a cell need only
+  // be no closer than the start's.
+  const double at_start = map.DistanceToObstacleAtCell(map.CellCentre(from)) - half_width;
+  std::vector<double> clearance(static_cast<std::size_t>(rows) * cols);
+  std::vector<char> free(clearance.size(), 0);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const Eigen::Vector2d centre = map.CellCentre({c, r});
+      const double d = map.DistanceToObstacleAtCell(centre) - half_width;
+      const bool near_start = (centre - Eigen::Vector2d(start.x, start.y)).norm() < parameters.start_free_radius;
+      clearance[index(r, c)] = d;
+      free[index(r, c)] = d >= (near_start ? std::min(rule.At(centre), at_start) : rule.At(centre)) ? 1 : 0;
+    }
+  }
+  free[index(from.y, from.x)] = 1;
+  struct Edge {
+    double cost;
+  };
+  std::vector<std::pair<int, int>> edges;
+  std::vector<Edge> costs;
+  const double preferred = parameters.preferred_clearance;
+  const auto step_cost = [&](int a, int b, double length) {
+    const double d = 0.5 * (clearance[a] + clearance[b]);
+    const double penalty = preferred > 0.0 ? std::max(0.0, 1.0 - d / preferred) : 0.0;
+    return length * (1.0 + parameters.clearance_cost * penalty);
+  };
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (!free[index(r, c)]) continue;
+      for (const auto& [dr, dc] : {std::pair{0, 1}, {1, 0}, {1, 1}, {1, -1}}) {
+        const int r2 = r + dr, c2 = c + dc;
+        if (r2 >= rows || c2 < 0 || c2 >= cols || !free[index(r2, c2)]) continue;
+        if (dr != 0 && dc != 0 && (!free[index(r, c2)] || !free[index(r2, c)])) continue;  // no corner cutting
+        const double length = map.resolution() * std::hypot(dr, dc);
+        for (const auto& [a, b] : {std::pair{index(r, c), index(r2, c2)}, {index(r2, c2), index(r, c)}}) {
+          edges.emplace_back(a, b);
+          costs.push_back({step_cost(a, b, length)});
+        }
+      }
+    }
+  }
+  using Graph = boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, Edge>;
+  const Graph graph(boost::edges_are_unsorted_multi_pass, edges.begin(), edges.end(), costs.begin(),
+                    static_cast<std::size_t>(rows) * cols);
+  std::vector<Graph::vertex_descriptor> predecessor(num_vertices(graph));
+  std::vector<double> distance(num_vertices(graph));
+  boost::dijkstra_shortest_paths(
+      graph, static_cast<Graph::vertex_descriptor>(index(from.y, from.x)),
+      boost::predecessor_map(boost::make_iterator_property_map(predecessor.begin(), get(boost::vertex_index, graph)))
+          .distance_map(boost::make_iterator_property_map(distance.begin(), get(boost::vertex_index, graph)))
+          .weight_map(get(&Edge::cost, graph)));
+  // The goal's cell, or the reached cell nearest the goal (a goal tight beside an obstacle, where
+  // the outline fits only along it): the last motion to the goal is checked like the others.
+  int target = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  const int reach = static_cast<int>(std::ceil(0.5 / map.resolution()));
+  for (int r = std::max(0, to.y - reach); r <= std::min(rows - 1, to.y + reach); ++r) {
+    for (int c = std::max(0, to.x - reach); c <= std::min(cols - 1, to.x + reach); ++c) {
+      const int v = index(r, c);
+      if (!std::isfinite(distance[v]) || distance[v] == std::numeric_limits<double>::max()) continue;
+      const double d = (map.CellCentre({c, r}) - goal).norm();
+      if (d < nearest) {
+        nearest = d;
+        target = v;
+      }
+    }
+  }
+  if (target < 0) return {};
+  std::vector<Eigen::Vector2d> cells;
+  for (int v = target; v != index(from.y, from.x); v = static_cast<int>(predecessor[v])) {
+    cells.push_back(map.CellCentre({v % cols, v / cols}));
+    if (predecessor[v] == static_cast<Graph::vertex_descriptor>(v)) return {};  // not reached
+  }
+  std::reverse(cells.begin(), cells.end());
+  // A vertex about every 0.4 m, headed along its incoming step; then the goal.
+  std::vector<Pose2> poses{start};
+  double since = 0.0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const Eigen::Vector2d previous = k == 0 ? Eigen::Vector2d(start.x, start.y) : cells[k - 1];
+    since += (cells[k] - previous).norm();
+    if (since < 0.4 && k + 1 < cells.size()) continue;
+    const Pose2& last = poses.back();
+    if (std::hypot(cells[k].x() - last.x, cells[k].y() - last.y) < 1e-9) continue;
+    poses.push_back({cells[k].x(), cells[k].y(), std::atan2(cells[k].y() - last.y, cells[k].x() - last.x)});
+    since = 0.0;
+  }
+  const Pose2& last = poses.back();
+  if (std::hypot(goal.x() - last.x, goal.y() - last.y) > 1e-9) {
+    poses.push_back({goal.x(), goal.y(), std::atan2(goal.y() - last.y, goal.x() - last.x)});
+  }
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    if (!MotionClear(planner, rule, poses[k - 1], poses[k])) return {};
+  }
+  return poses;
+}
+
 }  // namespace
 
 std::optional<double> GlobalPlanner::FreeHeading(const Eigen::Vector2d& position) const {
@@ -219,7 +383,7 @@ std::optional<double> GlobalPlanner::FreeHeading(const Eigen::Vector2d& position
 }
 
 std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vector2d& point, double radius,
-                                                                int count) const {
+                                                               int count) const {
   std::vector<Eigen::Vector2d> positions;
   if (count <= 0) return positions;
   if (FreeHeading(point) && Enterable(*this, point)) positions.push_back(point);
@@ -246,8 +410,8 @@ double GlobalPlanner::MotionCost(const Pose2& a, const Pose2& b) const {
   const double length = std::hypot(b.x - a.x, b.y - a.y);
   if (length < 1e-9) return parameters_.turn_cost * std::abs(WrapAngle(b.yaw - a.yaw));
   const double heading = std::atan2(b.y - a.y, b.x - a.x);
-  double cost = length + parameters_.turn_cost *
-                             (std::abs(WrapAngle(heading - a.yaw)) + std::abs(WrapAngle(b.yaw - heading)));
+  double cost =
+      length + parameters_.turn_cost * (std::abs(WrapAngle(heading - a.yaw)) + std::abs(WrapAngle(b.yaw - heading)));
   // Clearance below the preferred costs extra, sampled at the middles of 0.2 m pieces. For speed
   // (RRT* costs every candidate edge: this is most of its time) the clearance here is the distance
   // from the outline's centre to the nearest occupied cell less its half width - exact beside a
@@ -364,44 +528,35 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
   ob::IterationTerminationCondition budget(iterations);
   const ob::PlannerStatus status = planner->solve(budget);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+  std::vector<Pose2> route = GridRoute(*this, rule, planning_start, goal);
+  if (!route.empty()) Shortcut(*this, rule, &route);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION && route.empty()) {
     result.message = std::string("no path found (") + status.asString() + ", " +
                      std::to_string(problem->getSolutionDifference()) + " m short)";
     return result;
   }
-  auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
-  // Only simplifications that join existing vertices: OMPL's shortcutting also joins points
-  // interpolated within a motion, assuming a part of a valid motion is valid - not so for
-  // turn-drive-turn motions (the interpolated pose's heading makes its own turn).
-  og::PathSimplifier simplifier(si, problem->getGoal(), objective);
-  for (bool changed = true; changed;) {
-    changed = simplifier.reduceVertices(path);
-    changed = simplifier.collapseCloseVertices(path) || changed;
-  }
-
   std::vector<Pose2> poses;
-  for (const ob::State* state : path.getStates()) poses.push_back(ToPose(state));
-  // Ended on an approach pose: drive straight in.
-  for (const Pose2& approach : approaches) {
-    if (std::hypot(poses.back().x - approach.x, poses.back().y - approach.y) <= tolerance + 1e-9) {
-      poses.push_back({goal.x(), goal.y(), approach.yaw});
-      break;
+  if (status == ob::PlannerStatus::EXACT_SOLUTION) {
+    auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
+    // Only simplifications that join existing vertices: OMPL's shortcutting also joins points
+    // interpolated within a motion, assuming a part of a valid motion is valid - not so for
+    // turn-drive-turn motions (the interpolated pose's heading makes its own turn).
+    og::PathSimplifier simplifier(si, problem->getGoal(), objective);
+    for (bool changed = true; changed;) {
+      changed = simplifier.reduceVertices(path);
+      changed = simplifier.collapseCloseVertices(path) || changed;
     }
-  }
-  // RRT* stops after a fixed number of iterations, often on a detour (round a bush instead of
-  // along the open lane beside it), and reduceVertices joins random pairs. Greedy shortcutting
-  // from each vertex to the farthest one it reaches directly, when that motion is clear and
-  // cheaper than the vertices between, removes the detours deterministically.
-  for (std::size_t i = 0; i + 2 < poses.size(); ++i) {
-    for (std::size_t j = poses.size() - 1; j > i + 1; --j) {
-      double via = 0.0;
-      for (std::size_t k = i + 1; k <= j; ++k) via += MotionCost(poses[k - 1], poses[k]);
-      if (MotionCost(poses[i], poses[j]) < via && MotionClear(*this, rule, poses[i], poses[j])) {
-        poses.erase(poses.begin() + static_cast<std::ptrdiff_t>(i) + 1, poses.begin() + static_cast<std::ptrdiff_t>(j));
+    for (const ob::State* state : path.getStates()) poses.push_back(ToPose(state));
+    // Ended on an approach pose: drive straight in.
+    for (const Pose2& approach : approaches) {
+      if (std::hypot(poses.back().x - approach.x, poses.back().y - approach.y) <= tolerance + 1e-9) {
+        poses.push_back({goal.x(), goal.y(), approach.yaw});
         break;
       }
     }
+    Shortcut(*this, rule, &poses);
   }
+  if (poses.empty() || (!route.empty() && PathCost(*this, route) < PathCost(*this, poses))) poses = route;
   // The follower turns at each vertex from the incoming to the outgoing direction; the motions
   // checked turned through the vertex's own heading. Give the vertices their arrival headings and
   // keep that if it is still clear (it nearly always is).

@@ -150,7 +150,14 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
     Emit(stamp, NavigationEvent::Type::kPlanFailed, plan.message);
-    if (++plan_failures_ >= parameters_.max_plan_failures) GiveUpGoal(stamp, "no path: " + plan.message);
+    if (++plan_failures_ >= parameters_.max_plan_failures) {
+      GiveUpGoal(stamp, "no path: " + plan.message);
+    } else {
+      // Boxed in (no room to turn, and the drive plans forward motions only): back out the way it
+      // came before the next try, as after an obstacle stop.
+      backoff_start_ = {estimate.x, estimate.y};
+      mode_ = Mode::kBackingOff;
+    }
     return;
   }
   follower_.SetPath(plan.path);
@@ -195,7 +202,8 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   if (mode_ == Mode::kBackingOff) {
     // Straight back until the outline is clear again (or the back-off distance is used up).
     const double moved = (Eigen::Vector2d(estimate.x, estimate.y) - backoff_start_).norm();
-    if (OutlineClearance(estimate, parameters_.resume_clearance) >= parameters_.resume_clearance || moved >= parameters_.max_backoff) {
+    if (OutlineClearance(estimate, parameters_.resume_clearance) >= parameters_.resume_clearance ||
+        moved >= parameters_.max_backoff) {
       Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
       mode_ = Mode::kIdle;
       return stop;  // plan on the next update, from where the robot stopped
@@ -221,8 +229,10 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   const bool turning_in_place = follow.command.linear == 0.0 && follow.command.angular != 0.0;
   Pose2 turned = estimate;
   turned.yaw += std::copysign(parameters_.turn_check_angle, follow.command.angular);
-  const bool too_close = (follow.command.linear > 0.0 && OutlineClearance(estimate, parameters_.stop_clearance) < parameters_.stop_clearance) ||
-                         (turning_in_place && OutlineClearance(turned, parameters_.stop_clearance) < parameters_.stop_clearance);
+  const bool too_close =
+      (follow.command.linear > 0.0 &&
+       OutlineClearance(estimate, parameters_.stop_clearance) < parameters_.stop_clearance) ||
+      (turning_in_place && OutlineClearance(turned, parameters_.stop_clearance) < parameters_.stop_clearance);
   if (too_close) {
     Emit(stamp, NavigationEvent::Type::kObstacleStop, turning_in_place ? "turning" : "driving");
     if (++recoveries_ > parameters_.max_recoveries_per_goal) {

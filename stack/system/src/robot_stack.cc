@@ -240,6 +240,7 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   state.mission.UpdateTelemetry(*navigator, &telemetry_);
   const double planning = navigator->planning_seconds() - planning_before;
   telemetry_.timings.planning += planning;
+  if (planning > 0.0) telemetry_.timings.plans.push_back(planning);  // a navigator update makes at most one plan
   const double control = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - planning;
   telemetry_.timings.control += control;
 }

@@ -26,7 +26,11 @@ struct GeneratorParameters {
   int trees = 2;
   int obstacles = 2;
   int paths = 2;
-  bool fence = true;             // a low fence around the garden
+  // Pairs of parallel hedges with a corridor between them the robot must drive through (its width
+  // drawn from corridor_width; the hedges' ends are open).
+  int corridors = 0;
+  Eigen::Vector2d corridor_width = Eigen::Vector2d(1.0, 1.2);  // m, min and max
+  bool fence = true;                                           // a low fence around the garden
   double robot_clearance = 0.9;  // m of free space kept between objects so the robot can pass
 };
 // A new garden from the parameters; the same seed gives the same garden. Objects do not overlap

@@ -28,15 +28,15 @@
 namespace trimbot::stack {
 
 struct PlannerParameters {
-  double min_clearance = 0.05;        // m: the outline's clearance from every occupied cell
-  double preferred_clearance = 0.4;   // m: less than this costs extra ...
-  double clearance_cost = 2.0;        // ... up to this many metres per metre driven at no clearance
-  double turn_cost = 0.4;             // m per rad turned on the spot (set from the follower's speeds)
-  double start_free_radius = 0.25;    // m: near the start the outline need only get no closer to an
-                                      // obstacle than it starts (after a stop it may be within min_clearance)
-  double start_escape_radius = 1.0;   // m: a start whose outline overlaps is moved out by up to this
-  int iterations = 3000;              // RRT* iterations per plan
-  double range = 1.5;                 // m: longest RRT* edge
+  double min_clearance = 0.05;       // m: the outline's clearance from every occupied cell
+  double preferred_clearance = 0.4;  // m: less than this costs extra ...
+  double clearance_cost = 2.0;       // ... up to this many metres per metre driven at no clearance
+  double turn_cost = 0.4;            // m per rad turned on the spot (set from the follower's speeds)
+  double start_free_radius = 0.25;   // m: near the start the outline need only get no closer to an
+                                     // obstacle than it starts (after a stop it may be within min_clearance)
+  double start_escape_radius = 1.0;  // m: a start whose outline overlaps is moved out by up to this
+  int iterations = 3000;             // RRT* iterations per plan
+  double range = 1.5;                // m: longest RRT* edge
 };
 
 struct PlanResult {

@@ -31,6 +31,7 @@ struct StackTimings {
   double bush = 0.0;                 // stereo on the pair facing a bush and the bush's shape fit
   long bush_frames = 0;              // frames that went through
   double planning = 0.0;             // global plans (RRT*)
+  std::vector<double> plans;         // each global plan's wall-clock seconds (goal candidates included)
   double arm = 0.0;                  // arm: stereo of its surroundings, planning, execution
   long arm_frames = 0;               // ring frames the arm's surroundings were perceived from
   double control = 0.0;              // navigator and path follower, planning excluded
