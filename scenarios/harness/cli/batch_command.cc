@@ -1,10 +1,12 @@
-// `trimbot run SCENARIO` and `trimbot merge SHARDS` (runners/batch.h, runners/batch_executor.h).
+// `trimbot run SCENARIO`, `trimbot suite SUITE` and `trimbot merge SHARDS` (runners/batch.h,
+// runners/batch_executor.h, runners/suite.h).
 #include <memory>
 
 #include "cli/command.h"
 
 #include "cli/cluster_options.h"
 #include "runners/batch_executor.h"
+#include "runners/suite.h"
 #include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
@@ -40,6 +42,26 @@ void AddBatchCommands(Commands& commands) {
     if (cluster->slurm && shard_option->count() > 0) throw InputError("--shard", "--slurm makes the shards itself");
     const auto executor = MakeExecutor(*cluster, options->paths, options->out_dir);
     return RunBatches(executor.get(), {*options}).front();
+  });
+
+  auto suite = std::make_shared<SuiteOptions>();
+  auto suite_gardens = std::make_shared<int>(0);
+  auto* suite_cmd = app.add_subcommand(
+      "suite", "navigation over many generated gardens with seeded goals (the regression benchmark): per-garden and "
+               "overall success, failure reasons, plan times");
+  suite_cmd->add_option("suite", suite->suite_path, "suite file (YAML, e.g. scenarios/suites/random_gardens.yaml)")
+      ->required();
+  suite_cmd->add_option("--out", suite->out_dir, "output folder")->required();
+  auto* gardens_option = suite_cmd->add_option("--gardens", *suite_gardens, "run only the first N gardens")
+                             ->check(CLI::Range(1, 10000));
+  suite_cmd->add_option("--jobs", suite->jobs, "trials in parallel within a garden (processes)")->check(CLI::Range(1, 256));
+  suite_cmd->add_option("--runner", suite->runner,
+                        "run each garden with this command instead, e.g. \"/old/trimbot --data-root /old/src\" (the "
+                        "same suite on another build)");
+  commands.OnRun(suite_cmd, [suite, suite_gardens, gardens_option, &commands] {
+    suite->paths = commands.paths();
+    if (gardens_option->count() > 0) suite->gardens = *suite_gardens;
+    return RunSuite(*suite);
   });
 
   auto shard_dirs = std::make_shared<std::vector<std::string>>();

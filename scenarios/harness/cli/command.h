@@ -44,7 +44,7 @@ class Commands {
 void AddDriveCommand(Commands& commands);
 void AddBenchCommand(Commands& commands);
 void AddGardenCommands(Commands& commands);        // garden import-csv | generate | export
-void AddBatchCommands(Commands& commands);         // run, merge
+void AddBatchCommands(Commands& commands);         // run, suite, merge
 void AddRegistrationCommands(Commands& commands);  // register, register-set
 void AddCompareCommand(Commands& commands);
 void AddTuningCommands(Commands& commands);  // sweep, tune, ablate

@@ -102,13 +102,13 @@ std::string BuildFingerprint() {
   return fingerprint;
 }
 
-namespace {
-
 std::string TrialDir(const std::string& out, int index) {
   std::ostringstream name;
   name << out << "/trials/" << std::setw(3) << std::setfill('0') << index;
   return name.str();
 }
+
+namespace {
 
 TrialResult Unfinished(int index, std::uint64_t seed, const std::string& status, const std::string& message) {
   TrialResult result;

@@ -43,6 +43,9 @@ struct BatchOptions {
   bool quiet = false;                  // no per-trial lines or report listing (sweeps, tuning)
 };
 
+// A trial's folder in a batch's output folder: <out>/trials/NNN.
+std::string TrialDir(const std::string& out, int index);
+
 // Runs the batch (or this shard of it) and writes the reports. Returns the exit code: 0 when every
 // pass criterion holds, 1 when one fails. Bad input throws InputError.
 int RunBatch(const BatchOptions& options);

@@ -200,10 +200,17 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   }
 
   if (mode_ == Mode::kBackingOff) {
-    // Straight back until the outline is clear again (or the back-off distance is used up).
+    // Straight back until the outline is clear again (or the back-off distance is used up, or
+    // the outline a few centimetres further back would come within stop_clearance of what is
+    // behind: reversing is checked like driving forward).
     const double moved = (Eigen::Vector2d(estimate.x, estimate.y) - backoff_start_).norm();
-    if (OutlineClearance(estimate, parameters_.resume_clearance) >= parameters_.resume_clearance ||
-        moved >= parameters_.max_backoff) {
+    constexpr double kLookBehind = 0.05;  // m: a little more than one update's travel backwards
+    const Pose2 behind{estimate.x - kLookBehind * std::cos(estimate.yaw),
+                       estimate.y - kLookBehind * std::sin(estimate.yaw), estimate.yaw};
+    const double here = OutlineClearance(estimate, parameters_.resume_clearance);
+    const double there = OutlineClearance(behind, parameters_.resume_clearance);
+    if (here >= parameters_.resume_clearance || moved >= parameters_.max_backoff ||
+        (there < parameters_.stop_clearance && there < here - 1e-3)) {
       Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
       mode_ = Mode::kIdle;
       return stop;  // plan on the next update, from where the robot stopped
