@@ -190,24 +190,43 @@ std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen:
   return best;
 }
 
+// Whether the base can turn all the way round at `pose`: the disc its farthest corner sweeps keeps
+// min_clearance (exact for a full turn, conservative for part of one).
+bool CanTurnRound(const GlobalPlanner& planner, const Pose2& pose) {
+  return planner.map().DistanceToObstacle({pose.x, pose.y}) >=
+         planner.outline().reach() + planner.parameters().min_clearance;
+}
+
+// Where the drive can come from to arrive at `at` going forwards: walking back along its heading
+// (every two cells, up to `max_run`) while the outline keeps the rule's clearance, the first pose
+// where the base can turn round. A goal beside a wall is reached by such a run along the wall;
+// nothing else (forward turn-drive-turn motions) can arrive there.
+std::optional<Pose2> TurnableApproach(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& at,
+                                      double max_run) {
+  const double step = 2.0 * planner.map().resolution();
+  const Eigen::Vector2d back(-std::cos(at.yaw), -std::sin(at.yaw));
+  Pose2 previous = at;
+  for (double d = step; d <= max_run + 1e-9; d += step) {
+    const Pose2 p{at.x + d * back.x(), at.y + d * back.y(), at.yaw};
+    if (!planner.Valid(p) || !MotionClear(planner, rule, p, previous)) return std::nullopt;  // the run is blocked
+    if (CanTurnRound(planner, p)) return p;
+    previous = p;
+  }
+  return std::nullopt;
+}
+
+constexpr double kMaxApproachRun = 4.0;  // m: the longest straight run into a goal the planner looks for
+
 // Whether the drive can arrive at `position` going forwards: some heading where the outline fits
-// and either turns all the way round there or has a straight run of a base length behind it that
-// keeps min_clearance. A pose that fits only backing in (a base with its rear to a wall, no room
-// to turn) is not a goal the drive can reach.
+// and the base either turns round there or has a straight run into it from where it can
+// (TurnableApproach). A pose that fits only backing in, or only with a turn that the obstacles
+// around it forbid, is not a goal the drive can reach.
 bool Enterable(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
   const ClearanceRule rule(planner);
-  const double wanted = planner.parameters().min_clearance;
-  const double step = 0.5 * planner.map().resolution();
   for (int k = 0; k < kHeadings; ++k) {
     const Pose2 at{position.x(), position.y(), WrapAngle(2.0 * M_PI * k / kHeadings)};
     if (!planner.Valid(at)) continue;
-    if (planner.outline().TurnClearance(planner.map(), at, at.yaw + 3.1, step, wanted) >= wanted &&
-        planner.outline().TurnClearance(planner.map(), at, at.yaw - 3.1, step, wanted) >= wanted) {
-      return true;
-    }
-    const double run = planner.outline().length();
-    const Pose2 behind{at.x - run * std::cos(at.yaw), at.y - run * std::sin(at.yaw), at.yaw};
-    if (planner.Valid(behind) && MotionClear(planner, rule, behind, at)) return true;
+    if (CanTurnRound(planner, at) || TurnableApproach(planner, rule, at, kMaxApproachRun)) return true;
   }
   return false;
 }
@@ -482,12 +501,11 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   // heading an approach pose behind it, from which the robot drives straight in. A pose tight
   // between obstacles can otherwise be entered only from a tree node in the narrow cone in line
   // with it; an approach pose is entered from any node that can turn there. It is a base length
-  // behind the goal; on a retry (attempt > 0), the first pose further back, up to 4 m, where the
-  // base can turn all the way round (a goal beside a wall is reached by a run along the wall).
+  // behind the goal, and the first pose further back, up to 4 m, where the base can turn all the
+  // way round (a goal beside a wall is reached by a run along the wall: TurnableApproach).
   auto goals = std::make_shared<ob::GoalStates>(si);
   goals->setThreshold(tolerance);
   std::vector<Pose2> approaches;
-  const double step = map_.resolution();
   for (const double yaw : goal_headings) {
     const Pose2 at{goal.x(), goal.y(), yaw};
     ob::ScopedState<ob::SE2StateSpace> state(space);
@@ -501,15 +519,9 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
     if (Valid(behind(outline_.length())) && MotionClear(*this, rule, behind(outline_.length()), at)) {
       candidates.push_back(behind(outline_.length()));
     }
-    for (double d = 2.0 * step; attempt > 0 && d <= 4.0; d += 2.0 * step) {
-      const Pose2 p = behind(d);
-      if (!Valid(p) || !MotionClear(*this, rule, p, behind(d - 2.0 * step))) break;  // the run is blocked
-      const double wanted = parameters_.min_clearance;
-      if (d > outline_.length() && outline_.TurnClearance(map_, p, yaw + 3.1, step, wanted) >= wanted &&
-          outline_.TurnClearance(map_, p, yaw - 3.1, step, wanted) >= wanted) {
-        candidates.push_back(p);
-        break;
-      }
+    if (const auto turnable = TurnableApproach(*this, rule, at, kMaxApproachRun);
+        turnable && std::hypot(turnable->x - at.x, turnable->y - at.y) > outline_.length()) {
+      candidates.push_back(*turnable);
     }
     for (const Pose2& approach : candidates) {
       SetPose(approach, state.get());
@@ -528,7 +540,18 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
   ob::IterationTerminationCondition budget(iterations);
   const ob::PlannerStatus status = planner->solve(budget);
+  // The grid route straight to the goal; where its last motion cannot arrive (no heading it comes
+  // in at fits there), to an approach pose and straight in from it.
   std::vector<Pose2> route = GridRoute(*this, rule, planning_start, goal);
+  for (std::size_t a = 0; route.empty() && a < approaches.size(); ++a) {
+    route = GridRoute(*this, rule, planning_start, {approaches[a].x, approaches[a].y});
+    const Pose2 in{goal.x(), goal.y(), approaches[a].yaw};
+    if (!route.empty() && MotionClear(*this, rule, route.back(), in)) {
+      route.push_back(in);
+    } else {
+      route.clear();
+    }
+  }
   if (!route.empty()) Shortcut(*this, rule, &route);
   if (status != ob::PlannerStatus::EXACT_SOLUTION && route.empty()) {
     result.message = std::string("no path found (") + status.asString() + ", " +
