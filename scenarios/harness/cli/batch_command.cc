@@ -47,14 +47,16 @@ void AddBatchCommands(Commands& commands) {
   auto suite = std::make_shared<SuiteOptions>();
   auto suite_gardens = std::make_shared<int>(0);
   auto* suite_cmd = app.add_subcommand(
-      "suite", "navigation over many generated gardens with seeded goals (the regression benchmark): per-garden and "
-               "overall success, failure reasons, plan times");
+      "suite",
+      "navigation over many generated gardens with seeded goals (the regression benchmark): per-garden and "
+      "overall success, failure reasons, plan times");
   suite_cmd->add_option("suite", suite->suite_path, "suite file (YAML, e.g. scenarios/suites/random_gardens.yaml)")
       ->required();
   suite_cmd->add_option("--out", suite->out_dir, "output folder")->required();
-  auto* gardens_option = suite_cmd->add_option("--gardens", *suite_gardens, "run only the first N gardens")
-                             ->check(CLI::Range(1, 10000));
-  suite_cmd->add_option("--jobs", suite->jobs, "trials in parallel within a garden (processes)")->check(CLI::Range(1, 256));
+  auto* gardens_option =
+      suite_cmd->add_option("--gardens", *suite_gardens, "run only the first N gardens")->check(CLI::Range(1, 10000));
+  suite_cmd->add_option("--jobs", suite->jobs, "trials in parallel within a garden (processes)")
+      ->check(CLI::Range(1, 256));
   suite_cmd->add_option("--runner", suite->runner,
                         "run each garden with this command instead, e.g. \"/old/trimbot --data-root /old/src\" (the "
                         "same suite on another build)");

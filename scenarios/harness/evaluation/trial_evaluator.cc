@@ -214,6 +214,7 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
     }
     if (event.type == Type::kRecovered) ++recoveries_;
     const bool known_goal = event.goal >= 0 && event.goal < static_cast<int>(goals_.size());
+    if (event.type == Type::kGoalFailed && known_goal) ++goals_given_up_;
     if (event.type == Type::kGoalReached && known_goal) {
       // Judged where the robot meant to arrive: the asked goal, or where it moved it (reported).
       GoalResult& goal = goals_[event.goal];
@@ -262,7 +263,9 @@ void TrialEvaluator::Finish(bool finished, double time_limit, const stack::Telem
   const bool all_reached = std::all_of(goals_.begin(), goals_.end(), [](const GoalResult& g) { return g.reached; });
   result->success = result->status == "completed" && all_reached && collisions_ == 0;
   if (result->status == "completed" && !result->success) {
-    result->message = !all_reached ? "a goal was declared reached outside the tolerance" : "collided with the garden";
+    result->message = goals_given_up_ > 0 ? "navigation gave up " + std::to_string(goals_given_up_) + " goal(s)"
+                      : !all_reached      ? "a goal was declared reached outside the tolerance"
+                                          : "collided with the garden";
   }
 }
 

@@ -87,6 +87,7 @@ class TrialEvaluator : public Observer {
   double contact_seconds_ = 0.0;
   int plans_ = 0, recoveries_ = 0;
   std::vector<bool> goal_planned_;
+  int goals_given_up_ = 0;  // kGoalFailed events (with stop_on_failure false the mission goes on)
   std::vector<double> sample_times_, fix_stamps_;  // for the localization rate
   long steps_ = 0;
   double timestep_ = 0.0;

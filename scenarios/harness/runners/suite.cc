@@ -2,9 +2,9 @@
 
 #include <sys/wait.h>
 
+#include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -148,8 +148,8 @@ int RunGarden(const SuiteOptions& options, const std::string& scenario, const st
     batch.quiet = true;
     return RunBatch(batch);
   }
-  const std::string command = options.runner + " run '" + scenario + "' --out '" + dir +
-                              "' --jobs " + std::to_string(options.jobs) + " > '" + dir + "/run.log' 2>&1";
+  const std::string command = options.runner + " run '" + scenario + "' --out '" + dir + "' --jobs " +
+                              std::to_string(options.jobs) + " > '" + dir + "/run.log' 2>&1";
   fs::create_directories(dir);
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : 3;
@@ -186,7 +186,8 @@ std::string TrialFailure(const TrialResult& trial) {
   if (trial.collisions > 0) return "collided with the garden";
   if (trial.status == "timeout") return "time limit";
   if (trial.status != "completed" && trial.status != "failed") return trial.status;
-  return trial.message.empty() ? "goal not reached" : trial.message.substr(0, trial.message.find(" goal"));
+  if (trial.message.rfind("navigation gave up", 0) == 0) return "navigation gave up a goal";
+  return trial.message.empty() ? "goal not reached" : trial.message;
 }
 
 }  // namespace
@@ -226,7 +227,8 @@ SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double min_distance, 
     }
   }
   if (cells.empty() || start_cells.empty()) {
-    throw InputError(what, "no free space: no cell is " + std::to_string(cells.empty() ? min_distance : start_distance) +
+    throw InputError(what, "no free space: no cell is " +
+                               std::to_string(cells.empty() ? min_distance : start_distance) +
                                " m from every obstacle");
   }
   Rng rng = MakeRng(seed, "suite_layout");
@@ -267,10 +269,12 @@ int RunSuite(const SuiteOptions& options) {
     const garden::GeneratorParameters parameters = DrawGarden(spec, seed);
     const garden::Garden garden = garden::GenerateGarden(parameters);
     WriteFileAtomically(dir + "/garden.yaml", garden.ToYaml());
-    const SuiteLayout layout = PlaceSuiteLayout(garden, min_distance, start_distance, spec.goals, seed, dir + "/garden.yaml");
+    const SuiteLayout layout =
+        PlaceSuiteLayout(garden, min_distance, start_distance, spec.goals, seed, dir + "/garden.yaml");
     WriteScenario(spec, g, dir + "/garden.yaml", layout, dir + "/scenario.yaml");
     const int code = RunGarden(options, dir + "/scenario.yaml", dir + "/batch");
-    if (code != 0 && code != 1) throw InputError(dir + "/scenario.yaml", "its batch ended with exit code " + std::to_string(code));
+    if (code != 0 && code != 1)
+      throw InputError(dir + "/scenario.yaml", "its batch ended with exit code " + std::to_string(code));
     const json summary = ReadJson(dir + "/batch/summary.json");
     planned += summary.value("trials_planned", 0);
     int reached = 0, contacts = 0;
@@ -337,14 +341,19 @@ int RunSuite(const SuiteOptions& options) {
               {"collisions", summary.metrics.value("collisions", 0.0)}};
   std::sort(plan_seconds.begin(), plan_seconds.end());
   if (!plan_seconds.empty()) {
-    const auto at = [&](double q) { return 1e3 * plan_seconds[static_cast<std::size_t>(q * (plan_seconds.size() - 1))]; };
+    const auto at = [&](double q) {
+      return 1e3 * plan_seconds[static_cast<std::size_t>(q * (plan_seconds.size() - 1))];
+    };
     report["navigation_planning_ms"] = {
         {"plans", plan_seconds.size()}, {"median", at(0.5)}, {"p90", at(0.9)}, {"max", at(1.0)}};
   }
   WriteFileAtomically(out + "/suite.json", report.dump(2));
 
   std::ostringstream md;
-  md << "# Suite " << spec.name << "\n\n" << spec.description << "\n\n| garden | seed | objects | corridors | clearance (m) | goals reached | contacts | given up |\n|---|---|---|---|---|---|---|---|\n";
+  md << "# Suite " << spec.name << "\n\n"
+     << spec.description
+     << "\n\n| garden | seed | objects | corridors | clearance (m) | goals reached | contacts | given up "
+        "|\n|---|---|---|---|---|---|---|---|\n";
   for (const json& row : rows) {
     std::string given_up;
     for (const json& reason : row["given_up"]) given_up += (given_up.empty() ? "" : "; ") + reason.get<std::string>();
@@ -357,14 +366,15 @@ int RunSuite(const SuiteOptions& options) {
      << " %; contacts: " << summary.metrics.value("collisions", 0.0) << "\n";
   WriteFileAtomically(out + "/suite.md", md.str());
 
-  std::cout << "\n" << spec.name << ": " << gardens << " gardens, goals reached "
+  std::cout << "\n"
+            << spec.name << ": " << gardens << " gardens, goals reached "
             << 100.0 * summary.metrics.value("goal_success_rate", 0.0) << " %, contacts "
             << summary.metrics.value("collisions", 0.0) << "\n";
   for (const auto& [reason, n] : trial_failures) std::cout << "  trials failed: " << reason << " x" << n << "\n";
   for (const auto& [reason, n] : goal_failures) std::cout << "  goals given up: " << reason << " x" << n << "\n";
   if (report.contains("navigation_planning_ms")) {
-    std::cout << "  plans: median " << report["navigation_planning_ms"]["median"].get<double>() << " ms, 90th percentile "
-              << report["navigation_planning_ms"]["p90"].get<double>() << " ms over "
+    std::cout << "  plans: median " << report["navigation_planning_ms"]["median"].get<double>()
+              << " ms, 90th percentile " << report["navigation_planning_ms"]["p90"].get<double>() << " ms over "
               << report["navigation_planning_ms"]["plans"].get<std::size_t>() << " plans\n";
   }
   for (const CriterionResult& c : summary.criteria) {

@@ -121,7 +121,14 @@ std::vector<NavigationEvent> Navigator::TakeEvents() {
 void Navigator::GiveUpGoal(double stamp, const std::string& why) {
   Emit(stamp, NavigationEvent::Type::kGoalFailed, why);
   follower_.SetPath({});
-  mode_ = Mode::kFailed;
+  if (parameters_.stop_on_failure) {
+    mode_ = Mode::kFailed;
+    return;
+  }
+  ++goal_;
+  recoveries_ = 0;
+  plan_failures_ = 0;
+  mode_ = goal_ < static_cast<int>(goals_.size()) ? Mode::kIdle : Mode::kDone;
 }
 
 void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {

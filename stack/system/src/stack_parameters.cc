@@ -129,6 +129,7 @@ void ReadNavigation(Reader& r, StackParameters& s) {
   r.Number("replan_deviation", &p.replan_deviation, 0.01, 100.0, "m");
   r.Integer("max_recoveries_per_goal", &p.max_recoveries_per_goal, 0, 1000);
   r.Integer("max_plan_failures", &p.max_plan_failures, 1, 1000);
+  r.Flag("stop_on_failure", &p.stop_on_failure);
   r.Number("goal_search_radius", &p.goal_search_radius, 0.0, 2.0, "m");
   r.Number("blocked_horizon", &p.blocked_horizon, 0.0, 100.0, "m");
   if (p.resume_clearance < p.stop_clearance) r.map().Fail("resume_clearance", "must be at least stop_clearance");

@@ -33,6 +33,7 @@ struct NavigatorParameters {
   double replan_deviation = 0.6;  // m off the path -> plan again
   int max_recoveries_per_goal = 5;
   int max_plan_failures = 3;        // per goal, then the goal is given up
+  bool stop_on_failure = true;      // a goal given up ends the mission (false: on to the next goal)
   double goal_search_radius = 0.6;  // m: a goal where the outline fits nowhere moves at most this far
   double blocked_horizon = 4.0;     // m of path ahead checked when the costmap changes: where the
                                     // outline, driving it, comes within planner.min_clearance of a
