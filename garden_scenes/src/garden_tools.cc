@@ -310,6 +310,24 @@ cv::Point OccupancyMap::Cell(const Eigen::Vector2d& point) const {
   return {column, occupied.rows - 1 - row_from_bottom};
 }
 
+namespace {
+
+bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point) {
+  const Eigen::Vector2d local = Eigen::Rotation2Dd(-object.yaw) * (point - object.position);
+  const Eigen::Vector2d half = object.size.head<2>() / 2;
+  if (object.shape == Shape::kBox) return std::abs(local.x()) <= half.x() && std::abs(local.y()) <= half.y();
+  return (local.x() / half.x()) * (local.x() / half.x()) + (local.y() / half.y()) * (local.y() / half.y()) <= 1.0;
+}
+
+}  // namespace
+
+const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance) {
+  for (const auto& object : garden.objects) {
+    if (object.base_height < clearance && InFootprint(object, point)) return &object;
+  }
+  return nullptr;
+}
+
 OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance) {
   OccupancyMap map;
   map.resolution = resolution;
@@ -317,35 +335,25 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
   const int columns = static_cast<int>(std::ceil(garden.size.x() / resolution));
   const int rows = static_cast<int>(std::ceil(garden.size.y() / resolution));
   map.occupied = cv::Mat::zeros(rows, columns, CV_8U);
-  const auto centre_of = [&](int column, int row) {
-    return Eigen::Vector2d(map.origin.x() + (column + 0.5) * resolution,
-                           map.origin.y() + (rows - 1 - row + 0.5) * resolution);
-  };
   for (const auto& object : garden.objects) {
     if (object.base_height >= clearance) continue;
-    // A cell is occupied when its centre lies in the object's footprint: the map is off by at most
-    // half a cell either way, not grown by a cell all round (as filling every cell the outline
-    // touches would, which closes a gap 0.2 m wider than the base to nearly the base's width).
-    const Eigen::Rotation2Dd to_object(-object.yaw);
-    const Eigen::Vector2d half = object.size.head<2>() / 2;
-    const auto inside = [&](const Eigen::Vector2d& point) {
-      const Eigen::Vector2d local = to_object * (point - object.position);
-      if (object.shape == Shape::kBox) return std::abs(local.x()) <= half.x() && std::abs(local.y()) <= half.y();
-      return (local.x() / half.x()) * (local.x() / half.x()) + (local.y() / half.y()) * (local.y() / half.y()) <= 1.0;
-    };
-    const double extent = half.norm();
-    const cv::Point a = map.Cell(object.position + Eigen::Vector2d(-extent, extent));
-    const cv::Point b = map.Cell(object.position + Eigen::Vector2d(extent, -extent));
-    for (int row = std::max(0, a.y); row <= std::min(rows - 1, b.y); ++row) {
-      for (int column = std::max(0, a.x); column <= std::min(columns - 1, b.x); ++column) {
-        if (inside(centre_of(column, row))) map.occupied.at<std::uint8_t>(row, column) = 255;
+    std::vector<cv::Point> polygon;
+    if (object.shape == Shape::kBox) {
+      for (const auto& corner : FootprintCorners(object.position, object.size.head<2>(), object.yaw)) {
+        polygon.push_back(map.Cell(corner));
+      }
+    } else {
+      for (int i = 0; i < 48; ++i) {
+        const double a = 2.0 * M_PI * i / 48;
+        const Eigen::Vector2d local(object.size.x() / 2 * std::cos(a), object.size.y() / 2 * std::sin(a));
+        polygon.push_back(map.Cell(object.position + Eigen::Rotation2Dd(object.yaw) * local));
       }
     }
-    // An object thinner than a cell still occupies the cell holding its centre.
-    const cv::Point centre = map.Cell(object.position);
-    if (centre.x >= 0 && centre.y >= 0 && centre.x < columns && centre.y < rows) {
-      map.occupied.at<std::uint8_t>(centre) = 255;
-    }
+    // Every cell the footprint touches: objects grow by up to a cell all round, a margin the
+    // planner's 5 cm wall relies on today (a survey is a few centimetres off, the base passes
+    // under tree crowns hanging near the map's clearance height). See docs/design.md.
+    cv::fillConvexPoly(map.occupied, polygon, cv::Scalar(255));
+    cv::polylines(map.occupied, polygon, true, cv::Scalar(255));  // thin objects keep at least one cell
   }
   return map;
 }

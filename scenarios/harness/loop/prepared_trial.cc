@@ -1,6 +1,12 @@
 #include "loop/prepared_trial.h"
 
+#include <cmath>
+#include <sstream>
+
 #include "loop/prior_knowledge.h"
+#include "trimbot/common/input_error.h"
+#include "trimbot/garden/garden_tools.h"
+#include "trimbot/robot/robot_description.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -30,6 +36,57 @@ std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const garden::Garden
   return truths;
 }
 
+std::string At(const Eigen::Vector2d& p) {
+  std::ostringstream text;
+  text.precision(3);
+  text << "(" << p.x() << ", " << p.y() << ")";
+  return text.str();
+}
+
+std::string Named(const garden::GardenObject& object) {
+  return "object " + std::to_string(object.id) + " (" + garden::ToString(object.object_class) + ")";
+}
+
+// Places the scenario names that cannot be: a start where the base's outline (the URDF's) overlaps
+// an object of the garden as it stands, a point goal outside the garden or inside an object.
+// InputError naming the scenario file, the start or goal, and the object.
+void CheckPlaces(const Scenario& scenario, const garden::Garden& garden, const ProjectPaths& paths) {
+  const double clearance = scenario.map_clearance_height;
+  const Eigen::Vector2d low = garden.centre - garden.size / 2, high = garden.centre + garden.size / 2;
+  const auto outside = [&](const Eigen::Vector2d& p) {
+    return (p.array() < low.array()).any() || (p.array() > high.array()).any();
+  };
+  const Pose2& start = scenario.setting.start;
+  const auto [min, max] = robot::RobotDescription::Load(paths.robot_files().urdf).BaseOutline();
+  constexpr double kStep = 0.02;  // m between the outline's probed points
+  for (double x = min.x(); x <= max.x() + 1e-9; x += kStep) {
+    for (double y = min.y(); y <= max.y() + 1e-9; y += kStep) {
+      const Eigen::Vector2d p =
+          Eigen::Vector2d(start.x, start.y) + Eigen::Rotation2Dd(start.yaw) * Eigen::Vector2d(x, y);
+      if (outside(p))
+        throw InputError(scenario.source, "start: the base at " + At({start.x, start.y}) +
+                                              " reaches outside the garden '" + garden.name + "'");
+      if (const garden::GardenObject* object = garden::ObjectAt(garden, p, clearance)) {
+        throw InputError(scenario.source,
+                         "start: the base's outline at " + At({start.x, start.y}) + " overlaps " + Named(*object));
+      }
+    }
+  }
+  for (std::size_t i = 0; i < scenario.goals.size(); ++i) {
+    const ScenarioGoal& goal = scenario.goals[i];
+    if (goal.bush != 0) continue;  // a bush goal is checked against the garden's bushes
+    const std::string what = "goals[" + std::to_string(i) + "] at " + At(goal.position);
+    if (outside(goal.position)) {
+      throw InputError(scenario.source, what + " is outside the garden '" + garden.name + "' (x " +
+                                            std::to_string(low.x()) + " .. " + std::to_string(high.x()) + ", y " +
+                                            std::to_string(low.y()) + " .. " + std::to_string(high.y()) + ")");
+    }
+    if (const garden::GardenObject* object = garden::ObjectAt(garden, goal.position, clearance)) {
+      throw InputError(scenario.source, what + " lies inside " + Named(*object));
+    }
+  }
+}
+
 }  // namespace
 
 PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths) {
@@ -37,6 +94,11 @@ PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths) 
   // In the order the checks have always run, so that the first problem is the one reported.
   prepared.stack_parameters = StackParametersFor(scenario, paths);
   prepared.garden = LoadGarden(scenario.setting, paths);
+  if (!scenario.arm_reach) {
+    garden::Garden in_trials = prepared.garden;  // with the objects the survey missed
+    in_trials.AddObjects(scenario.survey.unmapped_objects);
+    CheckPlaces(scenario, in_trials, paths);
+  }
   prepared.surveyed = SurveyedGarden(prepared.garden, scenario.survey, scenario.source);
   prepared.prior_map = PriorMap(scenario, prepared.surveyed);
   prepared.mission = MissionGoals(scenario, prepared.surveyed);

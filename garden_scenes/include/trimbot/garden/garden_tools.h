@@ -44,6 +44,9 @@ struct OccupancyMap {
   // Cell (column, row) holding a map point.
   cv::Point Cell(const Eigen::Vector2d& point) const;
 };
+// The first object whose footprint holds `point` and whose lowest point is below `clearance` (what
+// the robot can run into there), or null.
+const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance);
 // Footprints of every object whose lowest point is below `clearance` (tree crowns higher than the
 // robot are not obstacles to it; their trunks are).
 OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance);
