@@ -15,6 +15,7 @@
 #include "loop/scenario.h"
 #include "loop/simulated_pose_fixes.h"
 #include "runners/batch.h"
+#include "runners/suite.h"
 #include "runners/trial.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
@@ -449,6 +450,76 @@ TEST(Batch, ATrialThatTimesOutIsRecordedWithItsSeedAndTheBatchGoesOn) {
   EXPECT_FALSE(summary["pass"].get<bool>());
   const std::string junit = testing::ReadText(out + "/junit.xml");
   EXPECT_NE(junit.find("<failure"), std::string::npos);
+}
+
+
+// Places a scenario names that cannot be are refused before any trial runs, naming the scenario
+// file, the start or goal, and the object.
+TEST(Scenario, StartsAndGoalsThatCannotBeAreRefusedNamingTheObject) {
+  const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
+  const struct {
+    std::string replace, with, expected;
+  } cases[] = {
+      {"- \\{x: 4.0, y: 0.0\\}", "- {x: 20.0, y: 0.0}", "goals[0] at (20, 0) is outside the garden 'test_lawn'"},
+      {"- \\{x: 4.0, y: 0.0\\}", "- {x: 8.5, y: 0.0}", "goals[0] at (8.5, 0) lies inside object 5 (hedge)"},
+      {"start: \\{x: 0.0, y: 0.0, yaw_deg: 0.0\\}", "start: {x: 3.0, y: 1.2, yaw_deg: 0.0}",
+       "start: the base's outline at (3, 1.2) overlaps object 1 (topiary)"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = SmokeVariant("places.yaml", c.replace, c.with);
+    const Scenario s = Scenario::Load(path);
+    try {
+      PrepareTrial(s, paths);
+      ADD_FAILURE() << "accepted: " << c.with;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The suite's goal rule never asks the planner: uniform over the cells at least the outline's
+// half-width plus the margin from every obstacle (the start: its reach plus the margin), the same
+// for the same seed; a garden with no such cell is refused naming it.
+TEST(Suite, GoalsAreDrawnWhereTheRuleSaysAndTheSameForTheSameSeed) {
+  garden::GeneratorParameters parameters;
+  parameters.seed = 7;
+  parameters.size = {8.0, 6.0};
+  parameters.corridors = 1;
+  const garden::Garden garden = garden::GenerateGarden(parameters);
+  const double goal_distance = 0.305, start_distance = 0.68;
+  const SuiteLayout a = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 11, "garden");
+  const SuiteLayout b = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 11, "garden");
+  const SuiteLayout c = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 12, "garden");
+  ASSERT_EQ(a.goals.size(), 20u);
+  EXPECT_EQ(a.goals, b.goals);
+  EXPECT_NE(a.goals, c.goals);
+  // Around each place, no object's footprint within its distance (less a cell's diagonal: the map's
+  // cells are whole squares).
+  const auto clear_within = [&](const Eigen::Vector2d& p, double r) {
+    for (int k = 0; k < 64; ++k) {
+      const double angle = 2.0 * M_PI * k / 64;
+      for (double d = 0.0; d <= r - 0.071; d += 0.02) {
+        if (garden::ObjectAt(garden, p + d * Eigen::Vector2d(std::cos(angle), std::sin(angle)), 1.0) != nullptr) {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
+  for (const auto& goal : a.goals) EXPECT_TRUE(clear_within(goal, goal_distance)) << goal.transpose();
+  EXPECT_TRUE(clear_within({a.start.x, a.start.y}, start_distance));
+  // Inside the fence.
+  for (const auto& goal : a.goals) EXPECT_LT(goal.cwiseAbs().maxCoeff(), 4.0) << goal.transpose();
+
+  garden::Garden full = garden;
+  garden::GardenObject block;
+  block.id = 900;
+  block.object_class = garden::ObjectClass::kObstacle;
+  block.shape = garden::Shape::kBox;
+  block.size = {30.0, 30.0, 1.0};
+  full.AddObjects({block});
+  EXPECT_THROW(PlaceSuiteLayout(full, goal_distance, start_distance, 4, 11, "full.yaml"), InputError);
 }
 
 }  // namespace
