@@ -452,7 +452,6 @@ TEST(Batch, ATrialThatTimesOutIsRecordedWithItsSeedAndTheBatchGoesOn) {
   EXPECT_NE(junit.find("<failure"), std::string::npos);
 }
 
-
 // Places a scenario names that cannot be are refused before any trial runs, naming the scenario
 // file, the start or goal, and the object.
 TEST(Scenario, StartsAndGoalsThatCannotBeAreRefusedNamingTheObject) {

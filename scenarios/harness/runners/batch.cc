@@ -219,6 +219,13 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   return timing;
 }
 
+// "<what>: median M ms, 90th percentile P ms, max X ms over N plans" (nothing without plans).
+void LogPlanTimes(std::ostream& log, const std::string& what, const json& plans) {
+  if (plans.is_null()) return;
+  log << what << ": median " << plans["median"].get<double>() << " ms, 90th percentile " << plans["p90"].get<double>()
+      << " ms, max " << plans["max"].get<double>() << " ms over " << plans["plans"].get<int>() << " plans\n";
+}
+
 // Summary, JUnit and plots of a set of trial results, written into `out`; returns the exit code.
 // `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
 // `final_out`: the folder the log names (merge builds the reports beside it and swaps them in).
@@ -288,18 +295,8 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
         << c.actual << ")\n";
   }
   if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
-  if (!timing.navigation_planning.is_null()) {
-    const json& plans = timing.navigation_planning;
-    log << "navigation planning (wall clock, goal candidates included): median " << plans["median"].get<double>()
-        << " ms, 90th percentile " << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>()
-        << " ms over " << plans["plans"].get<int>() << " plans\n";
-  }
-  if (!timing.arm_planning.is_null()) {
-    const json& plans = timing.arm_planning;
-    log << "arm planning (wall clock, IK included): median " << plans["median"].get<double>() << " ms, 90th percentile "
-        << plans["p90"].get<double>() << " ms, max " << plans["max"].get<double>() << " ms over "
-        << plans["plans"].get<int>() << " plans\n";
-  }
+  LogPlanTimes(log, "navigation planning (wall clock, goal candidates included)", timing.navigation_planning);
+  LogPlanTimes(log, "arm planning (wall clock, IK included)", timing.arm_planning);
   log << "outputs in " << final_out << " (summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach
               ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"

@@ -244,37 +244,20 @@ SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double min_distance, 
   return layout;
 }
 
-int RunSuite(const SuiteOptions& options) {
-  const SuiteSpec spec = LoadSuite(options.suite_path);
-  const int gardens = std::min(spec.gardens, options.gardens.value_or(spec.gardens));
-  const auto [outline_min, outline_max] = robot::RobotDescription::Load(options.paths.robot_files().urdf).BaseOutline();
-  const double min_distance = 0.5 * (outline_max.y() - outline_min.y()) + spec.goal_margin;
-  double reach = 0.0;  // the outline's farthest corner from base_link
-  for (const double x : {outline_min.x(), outline_max.x()}) {
-    for (const double y : {outline_min.y(), outline_max.y()}) reach = std::max(reach, std::hypot(x, y));
-  }
-  const double start_distance = reach + spec.goal_margin;
-  const std::string out = fs::absolute(options.out_dir).lexically_normal().string();
-  fs::create_directories(out + "/gardens");
+namespace {
 
+// What the gardens' batches came to: all their trials as one batch, a row per garden, failure
+// reasons counted, every plan's wall time.
+struct SuiteTally {
   std::vector<TrialResult> trials;
+  int planned = 0;
   json rows = json::array();
   std::map<std::string, int> trial_failures, goal_failures;
   std::vector<double> plan_seconds;
-  int planned = 0;
-  for (int g = 0; g < gardens; ++g) {
-    const std::uint64_t seed = spec.seed + static_cast<std::uint64_t>(g);
-    const std::string dir = GardenDir(out, g);
-    fs::create_directories(dir);
-    const garden::GeneratorParameters parameters = DrawGarden(spec, seed);
-    const garden::Garden garden = garden::GenerateGarden(parameters);
-    WriteFileAtomically(dir + "/garden.yaml", garden.ToYaml());
-    const SuiteLayout layout =
-        PlaceSuiteLayout(garden, min_distance, start_distance, spec.goals, seed, dir + "/garden.yaml");
-    WriteScenario(spec, g, dir + "/garden.yaml", layout, dir + "/scenario.yaml");
-    const int code = RunGarden(options, dir + "/scenario.yaml", dir + "/batch");
-    if (code != 0 && code != 1)
-      throw InputError(dir + "/scenario.yaml", "its batch ended with exit code " + std::to_string(code));
+
+  // Adds garden `g`'s batch (in `dir`/batch); returns its row.
+  const json& AddGarden(int g, std::uint64_t seed, const std::string& dir, const garden::Garden& garden,
+                        const garden::GeneratorParameters& parameters, int goals_per_trial) {
     const json summary = ReadJson(dir + "/batch/summary.json");
     planned += summary.value("trials_planned", 0);
     int reached = 0, contacts = 0;
@@ -298,29 +281,32 @@ int RunSuite(const SuiteOptions& options) {
       trial.index = static_cast<int>(trials.size());
       trials.push_back(trial);
     }
-    const int goals = spec.goals * static_cast<int>(summary["trials"].size());
     rows.push_back({{"garden", g},
                     {"seed", seed},
                     {"folder", dir},
                     {"objects", garden.objects.size()},
                     {"corridors", parameters.corridors},
                     {"clearance_m", parameters.robot_clearance},
-                    {"goals", goals},
+                    {"goals", goals_per_trial * static_cast<int>(summary["trials"].size())},
                     {"goals_reached", reached},
                     {"collisions", contacts},
                     {"trial_seeds", seeds},
                     {"given_up", reasons}});
-    std::printf("[suite] garden %03d (seed %llu): %d of %d goals, %d contacts%s\n", g,
-                static_cast<unsigned long long>(seed), reached, goals, contacts, code == 0 ? "" : " - FAILED");
+    return rows.back();
   }
+};
 
+// summary.json and junit.xml (the suite as one batch, against its criteria), suite.json, suite.md
+// and the console report; returns the exit code.
+int WriteSuiteReports(const SuiteSpec& spec, const SuiteOptions& options, const std::string& out,
+                      const SuiteTally& tally, int gardens) {
   BatchSummary summary;
   summary.scenario = spec.name;
   summary.scenario_file = options.suite_path;
   summary.seed = spec.seed;
-  summary.trials_planned = planned;
-  summary.trials = trials;
-  summary.metrics = ComputeBatchMetrics(trials, planned);
+  summary.trials_planned = tally.planned;
+  summary.trials = tally.trials;
+  summary.metrics = ComputeBatchMetrics(tally.trials, tally.planned);
   summary.pass = true;
   for (const PassCriterion& criterion : spec.criteria) {
     CriterionResult c{criterion.metric, criterion.comparison, criterion.threshold, std::nan(""), false};
@@ -334,11 +320,12 @@ int RunSuite(const SuiteOptions& options) {
 
   json report{{"suite", spec.name},
               {"file", options.suite_path},
-              {"gardens", rows},
-              {"trial_failures", trial_failures},
-              {"goals_given_up", goal_failures},
+              {"gardens", tally.rows},
+              {"trial_failures", tally.trial_failures},
+              {"goals_given_up", tally.goal_failures},
               {"goal_success_rate", summary.metrics.value("goal_success_rate", 0.0)},
               {"collisions", summary.metrics.value("collisions", 0.0)}};
+  std::vector<double> plan_seconds = tally.plan_seconds;
   std::sort(plan_seconds.begin(), plan_seconds.end());
   if (!plan_seconds.empty()) {
     const auto at = [&](double q) {
@@ -354,7 +341,7 @@ int RunSuite(const SuiteOptions& options) {
      << spec.description
      << "\n\n| garden | seed | objects | corridors | clearance (m) | goals reached | contacts | given up "
         "|\n|---|---|---|---|---|---|---|---|\n";
-  for (const json& row : rows) {
+  for (const json& row : tally.rows) {
     std::string given_up;
     for (const json& reason : row["given_up"]) given_up += (given_up.empty() ? "" : "; ") + reason.get<std::string>();
     md << "| " << row["garden"].get<int>() << " | " << row["seed"].get<std::uint64_t>() << " | "
@@ -370,8 +357,8 @@ int RunSuite(const SuiteOptions& options) {
             << spec.name << ": " << gardens << " gardens, goals reached "
             << 100.0 * summary.metrics.value("goal_success_rate", 0.0) << " %, contacts "
             << summary.metrics.value("collisions", 0.0) << "\n";
-  for (const auto& [reason, n] : trial_failures) std::cout << "  trials failed: " << reason << " x" << n << "\n";
-  for (const auto& [reason, n] : goal_failures) std::cout << "  goals given up: " << reason << " x" << n << "\n";
+  for (const auto& [reason, n] : tally.trial_failures) std::cout << "  trials failed: " << reason << " x" << n << "\n";
+  for (const auto& [reason, n] : tally.goal_failures) std::cout << "  goals given up: " << reason << " x" << n << "\n";
   if (report.contains("navigation_planning_ms")) {
     std::cout << "  plans: median " << report["navigation_planning_ms"]["median"].get<double>()
               << " ms, 90th percentile " << report["navigation_planning_ms"]["p90"].get<double>() << " ms over "
@@ -383,6 +370,43 @@ int RunSuite(const SuiteOptions& options) {
   }
   std::cout << "outputs in " << out << " (summary.json, junit.xml, suite.json, suite.md; per garden gardens/NNN/)\n";
   return summary.pass ? 0 : 1;
+}
+
+}  // namespace
+
+int RunSuite(const SuiteOptions& options) {
+  const SuiteSpec spec = LoadSuite(options.suite_path);
+  const int gardens = std::min(spec.gardens, options.gardens.value_or(spec.gardens));
+  const auto [outline_min, outline_max] = robot::RobotDescription::Load(options.paths.robot_files().urdf).BaseOutline();
+  const double min_distance = 0.5 * (outline_max.y() - outline_min.y()) + spec.goal_margin;
+  double reach = 0.0;  // the outline's farthest corner from base_link
+  for (const double x : {outline_min.x(), outline_max.x()}) {
+    for (const double y : {outline_min.y(), outline_max.y()}) reach = std::max(reach, std::hypot(x, y));
+  }
+  const double start_distance = reach + spec.goal_margin;
+  const std::string out = fs::absolute(options.out_dir).lexically_normal().string();
+  fs::create_directories(out + "/gardens");
+  SuiteTally tally;
+  for (int g = 0; g < gardens; ++g) {
+    const std::uint64_t seed = spec.seed + static_cast<std::uint64_t>(g);
+    const std::string dir = GardenDir(out, g);
+    fs::create_directories(dir);
+    const garden::GeneratorParameters parameters = DrawGarden(spec, seed);
+    const garden::Garden garden = garden::GenerateGarden(parameters);
+    WriteFileAtomically(dir + "/garden.yaml", garden.ToYaml());
+    const SuiteLayout layout =
+        PlaceSuiteLayout(garden, min_distance, start_distance, spec.goals, seed, dir + "/garden.yaml");
+    WriteScenario(spec, g, dir + "/garden.yaml", layout, dir + "/scenario.yaml");
+    const int code = RunGarden(options, dir + "/scenario.yaml", dir + "/batch");
+    if (code != 0 && code != 1) {
+      throw InputError(dir + "/scenario.yaml", "its batch ended with exit code " + std::to_string(code));
+    }
+    const json& row = tally.AddGarden(g, seed, dir, garden, parameters, spec.goals);
+    std::printf("[suite] garden %03d (seed %llu): %d of %d goals, %d contacts%s\n", g,
+                static_cast<unsigned long long>(seed), row["goals_reached"].get<int>(), row["goals"].get<int>(),
+                row["collisions"].get<int>(), code == 0 ? "" : " - FAILED");
+  }
+  return WriteSuiteReports(spec, options, out, tally, gardens);
 }
 
 }  // namespace trimbot::scenarios

@@ -281,14 +281,34 @@ void Shortcut(const GlobalPlanner& planner, const ClearanceRule& rule, std::vect
   }
 }
 
+// Of the cells within 0.5 m of `goal`, the index (row * cols + column) of the one nearest it that
+// Dijkstra reached (`distance` finite), or -1.
+int NearestReached(const OccupancyGrid& map, const std::vector<double>& distance, const Eigen::Vector2d& goal) {
+  const int rows = map.occupied().rows, cols = map.occupied().cols;
+  const cv::Point to = map.Cell(goal);
+  int target = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  const int reach = static_cast<int>(std::ceil(0.5 / map.resolution()));
+  for (int r = std::max(0, to.y - reach); r <= std::min(rows - 1, to.y + reach); ++r) {
+    for (int c = std::max(0, to.x - reach); c <= std::min(cols - 1, to.x + reach); ++c) {
+      const double reached = distance[static_cast<std::size_t>(r * cols + c)];
+      if (!std::isfinite(reached) || reached == std::numeric_limits<double>::max()) continue;
+      const double d = (map.CellCentre({c, r}) - goal).norm();
+      if (d < nearest) {
+        nearest = d;
+        target = r * cols + c;
+      }
+    }
+  }
+  return target;
+}
+
 // The cheapest route for base_link over the map's cells (Dijkstra, Boost.Graph), where the outline
 // fits sideways (a cell's distance to the nearest obstacle less half the base's width keeps the
-// rule's clearance), each step costed as MotionCost costs clearance - then thinned to a vertex about
-// every 0.4 m and checked as the drive's motions with the whole outline. RRT* with a fixed number
-// of iterations can settle on the wrong side of a row of bushes, which no shortcutting undoes; this
-// route is the other candidate, and the cheaper valid one is kept. Empty when there is none.
-std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
-                             const Eigen::Vector2d& goal) {
+// rule's clearance), each step costed as MotionCost costs clearance: the cells' centres from the
+// start to the goal's cell (or the reached cell nearest the goal). Empty when there is none.
+std::vector<Eigen::Vector2d> RouteCells(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
+                                        const Eigen::Vector2d& goal) {
   const OccupancyGrid& map = planner.map();
   const PlannerParameters& parameters = planner.parameters();
   const int rows = map.occupied().rows, cols = map.occupied().cols;
@@ -350,20 +370,7 @@ std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& 
           .weight_map(get(&Edge::cost, graph)));
   // The goal's cell, or the reached cell nearest the goal (a goal tight beside an obstacle, where
   // the outline fits only along it): the last motion to the goal is checked like the others.
-  int target = -1;
-  double nearest = std::numeric_limits<double>::infinity();
-  const int reach = static_cast<int>(std::ceil(0.5 / map.resolution()));
-  for (int r = std::max(0, to.y - reach); r <= std::min(rows - 1, to.y + reach); ++r) {
-    for (int c = std::max(0, to.x - reach); c <= std::min(cols - 1, to.x + reach); ++c) {
-      const int v = index(r, c);
-      if (!std::isfinite(distance[v]) || distance[v] == std::numeric_limits<double>::max()) continue;
-      const double d = (map.CellCentre({c, r}) - goal).norm();
-      if (d < nearest) {
-        nearest = d;
-        target = v;
-      }
-    }
-  }
+  const int target = NearestReached(map, distance, goal);
   if (target < 0) return {};
   std::vector<Eigen::Vector2d> cells;
   for (int v = target; v != index(from.y, from.x); v = static_cast<int>(predecessor[v])) {
@@ -371,6 +378,17 @@ std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& 
     if (predecessor[v] == static_cast<Graph::vertex_descriptor>(v)) return {};  // not reached
   }
   std::reverse(cells.begin(), cells.end());
+  return cells;
+}
+
+// RouteCells thinned to a vertex about every 0.4 m, each headed along its incoming step, then the
+// goal, and checked as the drive's motions with the whole outline. RRT* with a fixed number of
+// iterations can settle on the wrong side of a row of bushes, which no shortcutting undoes; this
+// route is the other candidate, and the cheaper valid one is kept. Empty when there is none.
+std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
+                             const Eigen::Vector2d& goal) {
+  const std::vector<Eigen::Vector2d> cells = RouteCells(planner, rule, start, goal);
+  if (cells.empty()) return {};
   // A vertex about every 0.4 m, headed along its incoming step; then the goal.
   std::vector<Pose2> poses{start};
   double since = 0.0;
@@ -450,6 +468,145 @@ double GlobalPlanner::MotionCost(const Pose2& a, const Pose2& b) const {
   return cost;
 }
 
+namespace {
+
+// The approach poses of the goal pose `at`: a base length behind it, from which the robot drives
+// straight in, and the first pose further back, up to 4 m, where the base can turn all the way
+// round (a goal beside a wall is reached by a run along the wall: TurnableApproach). A pose tight
+// between obstacles can otherwise be entered only from a tree node in the narrow cone in line with
+// it; an approach pose is entered from any node that can turn there.
+std::vector<Pose2> ApproachPoses(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& at) {
+  std::vector<Pose2> approaches;
+  const double length = planner.outline().length();
+  const Pose2 behind{at.x - length * std::cos(at.yaw), at.y - length * std::sin(at.yaw), at.yaw};
+  if (planner.Valid(behind) && MotionClear(planner, rule, behind, at)) approaches.push_back(behind);
+  if (const auto turnable = TurnableApproach(planner, rule, at, kMaxApproachRun);
+      turnable && std::hypot(turnable->x - at.x, turnable->y - at.y) > length) {
+    approaches.push_back(*turnable);
+  }
+  return approaches;
+}
+
+// An RRT* search and what its path is simplified with.
+struct RrtStarSearch {
+  ob::SpaceInformationPtr si;
+  ob::ProblemDefinitionPtr problem;
+  ob::OptimizationObjectivePtr objective;
+  bool exact = false;  // found a path to a goal state
+};
+
+// RRT* in SE(2) from `start` to one of `goal_states` (the goal at each heading that fits, each
+// followed by its approach poses); `message` says why when it found no exact solution.
+RrtStarSearch SolveRrtStar(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
+                           const std::vector<Pose2>& goal_states, double tolerance, int attempt, std::string* message) {
+  const OccupancyGrid& map = planner.map();
+  auto space = std::make_shared<ob::SE2StateSpace>();
+  ob::RealVectorBounds bounds(2);
+  bounds.setLow(0, map.origin().x());
+  bounds.setLow(1, map.origin().y());
+  bounds.setHigh(0, map.origin().x() + map.size().x());
+  bounds.setHigh(1, map.origin().y() + map.size().y());
+  space->setBounds(bounds);
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([&planner, &rule](const ob::State* state) {
+    const Pose2 p = ToPose(state);
+    const double wanted = rule.At({p.x, p.y});
+    return planner.Clearance(p, wanted) >= wanted;
+  });
+  si->setMotionValidator(std::make_shared<DriveMotionValidator>(si, planner, rule));
+  si->setup();
+  ob::ScopedState<ob::SE2StateSpace> state(space);
+  SetPose(start, state.get());
+  auto problem = std::make_shared<ob::ProblemDefinition>(si);
+  problem->addStartState(state);
+  auto goals = std::make_shared<ob::GoalStates>(si);
+  goals->setThreshold(tolerance);
+  for (const Pose2& pose : goal_states) {
+    SetPose(pose, state.get());
+    goals->addState(state);
+  }
+  problem->setGoal(goals);
+  auto objective = std::make_shared<DriveObjective>(si, planner);
+  problem->setOptimizationObjective(objective);
+  auto rrt = std::make_shared<og::RRTstar>(si);
+  rrt->setRange(planner.parameters().range);
+  rrt->setKNearest(false);  // neighbours within the shrinking RRT* radius: fewer long edges to cost
+  rrt->setProblemDefinition(problem);
+  rrt->setup();
+  ob::IterationTerminationCondition budget(static_cast<unsigned>(planner.parameters().iterations)
+                                           << std::clamp(attempt, 0, 4));
+  const ob::PlannerStatus status = rrt->solve(budget);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    *message = std::string("no path found (") + status.asString() + ", " +
+               std::to_string(problem->getSolutionDifference()) + " m short)";
+  }
+  return {si, problem, objective, status == ob::PlannerStatus::EXACT_SOLUTION};
+}
+
+// The search's path, simplified and shortcut; ending on one of `approaches` it drives straight in
+// to `goal`. Empty without an exact solution.
+std::vector<Pose2> SimplifiedPath(const GlobalPlanner& planner, const ClearanceRule& rule, const RrtStarSearch& search,
+                                  const Eigen::Vector2d& goal, const std::vector<Pose2>& approaches, double tolerance) {
+  if (!search.exact) return {};
+  auto& path = *search.problem->getSolutionPath()->as<og::PathGeometric>();
+  // Only simplifications that join existing vertices: OMPL's shortcutting also joins points
+  // interpolated within a motion, assuming a part of a valid motion is valid - not so for
+  // turn-drive-turn motions (the interpolated pose's heading makes its own turn).
+  og::PathSimplifier simplifier(search.si, search.problem->getGoal(), search.objective);
+  for (bool changed = true; changed;) {
+    changed = simplifier.reduceVertices(path);
+    changed = simplifier.collapseCloseVertices(path) || changed;
+  }
+  std::vector<Pose2> poses;
+  for (const ob::State* s : path.getStates()) poses.push_back(ToPose(s));
+  for (const Pose2& approach : approaches) {  // ended on an approach pose: drive straight in
+    if (std::hypot(poses.back().x - approach.x, poses.back().y - approach.y) <= tolerance + 1e-9) {
+      poses.push_back({goal.x(), goal.y(), approach.yaw});
+      break;
+    }
+  }
+  Shortcut(planner, rule, &poses);
+  return poses;
+}
+
+// The grid route straight to the goal; where its last motion cannot arrive (no heading it comes
+// in at fits there), to an approach pose and straight in from it. Empty when there is none.
+std::vector<Pose2> GridRouteToGoal(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
+                                   const Eigen::Vector2d& goal, const std::vector<Pose2>& approaches) {
+  std::vector<Pose2> route = GridRoute(planner, rule, start, goal);
+  for (std::size_t a = 0; route.empty() && a < approaches.size(); ++a) {
+    route = GridRoute(planner, rule, start, {approaches[a].x, approaches[a].y});
+    const Pose2 in{goal.x(), goal.y(), approaches[a].yaw};
+    if (!route.empty() && MotionClear(planner, rule, route.back(), in)) {
+      route.push_back(in);
+    } else {
+      route.clear();
+    }
+  }
+  if (!route.empty()) Shortcut(planner, rule, &route);
+  return route;
+}
+
+// The follower turns at each vertex from the incoming to the outgoing direction; the motions
+// checked turned through the vertex's own heading. Give the vertices their arrival headings and
+// keep that if it is still clear (it nearly always is).
+std::vector<Pose2> WithArrivalHeadings(const GlobalPlanner& planner, const ClearanceRule& rule,
+                                       const std::vector<Pose2>& poses) {
+  std::vector<Pose2> arriving = poses;
+  for (std::size_t i = 1; i < arriving.size(); ++i) {
+    const Pose2& p = arriving[i - 1];
+    if (std::hypot(arriving[i].x - p.x, arriving[i].y - p.y) > 1e-9) {
+      arriving[i].yaw = std::atan2(arriving[i].y - p.y, arriving[i].x - p.x);
+    }
+  }
+  for (std::size_t i = 1; i < arriving.size(); ++i) {
+    if (!MotionClear(planner, rule, arriving[i - 1], arriving[i])) return poses;
+  }
+  return arriving;
+}
+
+}  // namespace
+
 PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt) const {
   PlanResult result;
   std::vector<double> goal_headings;
@@ -475,126 +632,24 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
     }
     planning_start = {free.front().x(), free.front().y(), *FreeHeading(free.front())};
   }
-
-  auto space = std::make_shared<ob::SE2StateSpace>();
-  ob::RealVectorBounds bounds(2);
-  bounds.setLow(0, map_.origin().x());
-  bounds.setLow(1, map_.origin().y());
-  bounds.setHigh(0, map_.origin().x() + map_.size().x());
-  bounds.setHigh(1, map_.origin().y() + map_.size().y());
-  space->setBounds(bounds);
-  auto si = std::make_shared<ob::SpaceInformation>(space);
   const ClearanceRule rule(*this, planning_start);
-  si->setStateValidityChecker([this, &rule](const ob::State* state) {
-    const Pose2 p = ToPose(state);
-    const double wanted = rule.At({p.x, p.y});
-    return Clearance(p, wanted) >= wanted;
-  });
-  si->setMotionValidator(std::make_shared<DriveMotionValidator>(si, *this, rule));
-  si->setup();
-
-  ob::ScopedState<ob::SE2StateSpace> from(space);
-  SetPose(planning_start, from.get());
-  auto problem = std::make_shared<ob::ProblemDefinition>(si);
-  problem->addStartState(from);
-  // The goal poses: the goal position at every heading the outline fits at, and for each such
-  // heading an approach pose behind it, from which the robot drives straight in. A pose tight
-  // between obstacles can otherwise be entered only from a tree node in the narrow cone in line
-  // with it; an approach pose is entered from any node that can turn there. It is a base length
-  // behind the goal, and the first pose further back, up to 4 m, where the base can turn all the
-  // way round (a goal beside a wall is reached by a run along the wall: TurnableApproach).
-  auto goals = std::make_shared<ob::GoalStates>(si);
-  goals->setThreshold(tolerance);
-  std::vector<Pose2> approaches;
+  std::vector<Pose2> goal_states, approaches;
   for (const double yaw : goal_headings) {
-    const Pose2 at{goal.x(), goal.y(), yaw};
-    ob::ScopedState<ob::SE2StateSpace> state(space);
-    SetPose(at, state.get());
-    goals->addState(state);
-    const Eigen::Vector2d back(-std::cos(yaw), -std::sin(yaw));
-    const auto behind = [&](double distance) {
-      return Pose2{goal.x() + distance * back.x(), goal.y() + distance * back.y(), yaw};
-    };
-    std::vector<Pose2> candidates;
-    if (Valid(behind(outline_.length())) && MotionClear(*this, rule, behind(outline_.length()), at)) {
-      candidates.push_back(behind(outline_.length()));
-    }
-    if (const auto turnable = TurnableApproach(*this, rule, at, kMaxApproachRun);
-        turnable && std::hypot(turnable->x - at.x, turnable->y - at.y) > outline_.length()) {
-      candidates.push_back(*turnable);
-    }
-    for (const Pose2& approach : candidates) {
-      SetPose(approach, state.get());
-      goals->addState(state);
-      approaches.push_back(approach);
-    }
+    goal_states.push_back({goal.x(), goal.y(), yaw});
+    const std::vector<Pose2> more = ApproachPoses(*this, rule, goal_states.back());
+    goal_states.insert(goal_states.end(), more.begin(), more.end());
+    approaches.insert(approaches.end(), more.begin(), more.end());
   }
-  problem->setGoal(goals);
-  auto objective = std::make_shared<DriveObjective>(si, *this);
-  problem->setOptimizationObjective(objective);
-  auto planner = std::make_shared<og::RRTstar>(si);
-  planner->setRange(parameters_.range);
-  planner->setKNearest(false);  // neighbours within the shrinking RRT* radius: fewer long edges to cost
-  planner->setProblemDefinition(problem);
-  planner->setup();
-  const unsigned iterations = static_cast<unsigned>(parameters_.iterations) << std::clamp(attempt, 0, 4);
-  ob::IterationTerminationCondition budget(iterations);
-  const ob::PlannerStatus status = planner->solve(budget);
-  // The grid route straight to the goal; where its last motion cannot arrive (no heading it comes
-  // in at fits there), to an approach pose and straight in from it.
-  std::vector<Pose2> route = GridRoute(*this, rule, planning_start, goal);
-  for (std::size_t a = 0; route.empty() && a < approaches.size(); ++a) {
-    route = GridRoute(*this, rule, planning_start, {approaches[a].x, approaches[a].y});
-    const Pose2 in{goal.x(), goal.y(), approaches[a].yaw};
-    if (!route.empty() && MotionClear(*this, rule, route.back(), in)) {
-      route.push_back(in);
-    } else {
-      route.clear();
-    }
-  }
-  if (!route.empty()) Shortcut(*this, rule, &route);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION && route.empty()) {
-    result.message = std::string("no path found (") + status.asString() + ", " +
-                     std::to_string(problem->getSolutionDifference()) + " m short)";
-    return result;
-  }
-  std::vector<Pose2> poses;
-  if (status == ob::PlannerStatus::EXACT_SOLUTION) {
-    auto& path = *problem->getSolutionPath()->as<og::PathGeometric>();
-    // Only simplifications that join existing vertices: OMPL's shortcutting also joins points
-    // interpolated within a motion, assuming a part of a valid motion is valid - not so for
-    // turn-drive-turn motions (the interpolated pose's heading makes its own turn).
-    og::PathSimplifier simplifier(si, problem->getGoal(), objective);
-    for (bool changed = true; changed;) {
-      changed = simplifier.reduceVertices(path);
-      changed = simplifier.collapseCloseVertices(path) || changed;
-    }
-    for (const ob::State* state : path.getStates()) poses.push_back(ToPose(state));
-    // Ended on an approach pose: drive straight in.
-    for (const Pose2& approach : approaches) {
-      if (std::hypot(poses.back().x - approach.x, poses.back().y - approach.y) <= tolerance + 1e-9) {
-        poses.push_back({goal.x(), goal.y(), approach.yaw});
-        break;
-      }
-    }
-    Shortcut(*this, rule, &poses);
-  }
+  // Two candidates, the cheaper valid one kept: RRT* and the grid route (GridRoute says why). In
+  // this order: both draw from OMPL's seeded generators, so the order fixes the plans.
+  const RrtStarSearch search =
+      SolveRrtStar(*this, rule, planning_start, goal_states, tolerance, attempt, &result.message);
+  const std::vector<Pose2> route = GridRouteToGoal(*this, rule, planning_start, goal, approaches);
+  std::vector<Pose2> poses = SimplifiedPath(*this, rule, search, goal, approaches, tolerance);
   if (poses.empty() || (!route.empty() && PathCost(*this, route) < PathCost(*this, poses))) poses = route;
-  // The follower turns at each vertex from the incoming to the outgoing direction; the motions
-  // checked turned through the vertex's own heading. Give the vertices their arrival headings and
-  // keep that if it is still clear (it nearly always is).
-  std::vector<Pose2> arriving = poses;
-  for (std::size_t i = 1; i < arriving.size(); ++i) {
-    const Pose2& p = arriving[i - 1];
-    if (std::hypot(arriving[i].x - p.x, arriving[i].y - p.y) > 1e-9) {
-      arriving[i].yaw = std::atan2(arriving[i].y - p.y, arriving[i].x - p.x);
-    }
-  }
-  bool arriving_clear = true;
-  for (std::size_t i = 1; i < arriving.size() && arriving_clear; ++i) {
-    arriving_clear = MotionClear(*this, rule, arriving[i - 1], arriving[i]);
-  }
-  if (arriving_clear) poses = arriving;
+  if (poses.empty()) return result;
+  result.message.clear();
+  poses = WithArrivalHeadings(*this, rule, poses);
 
   if (planning_start.x != start.x || planning_start.y != start.y) result.path.push_back({start.x, start.y});
   for (const Pose2& p : poses) {
