@@ -487,9 +487,9 @@ TEST(Suite, GoalsAreDrawnWhereTheRuleSaysAndTheSameForTheSameSeed) {
   parameters.corridors = 1;
   const garden::Garden garden = garden::GenerateGarden(parameters);
   const double goal_distance = 0.305, start_distance = 0.68;
-  const SuiteLayout a = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 11, "garden");
-  const SuiteLayout b = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 11, "garden");
-  const SuiteLayout c = PlaceSuiteLayout(garden, goal_distance, start_distance, 20, 12, "garden");
+  const SuiteLayout a = PlaceSuiteLayout(garden, 1.0, goal_distance, start_distance, 20, 11, "garden");
+  const SuiteLayout b = PlaceSuiteLayout(garden, 1.0, goal_distance, start_distance, 20, 11, "garden");
+  const SuiteLayout c = PlaceSuiteLayout(garden, 1.0, goal_distance, start_distance, 20, 12, "garden");
   ASSERT_EQ(a.goals.size(), 20u);
   EXPECT_EQ(a.goals, b.goals);
   EXPECT_NE(a.goals, c.goals);
@@ -518,7 +518,7 @@ TEST(Suite, GoalsAreDrawnWhereTheRuleSaysAndTheSameForTheSameSeed) {
   block.shape = garden::Shape::kBox;
   block.size = {30.0, 30.0, 1.0};
   full.AddObjects({block});
-  EXPECT_THROW(PlaceSuiteLayout(full, goal_distance, start_distance, 4, 11, "full.yaml"), InputError);
+  EXPECT_THROW(PlaceSuiteLayout(full, 1.0, goal_distance, start_distance, 4, 11, "full.yaml"), InputError);
 }
 
 }  // namespace

@@ -312,9 +312,22 @@ cv::Point OccupancyMap::Cell(const Eigen::Vector2d& point) const {
 
 namespace {
 
-bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point) {
+// How much of an object's footprint its part below `clearance` covers: all of it for boxes and
+// cylinders (upright prisms) and for ellipsoids reaching their widest below it, else the ellipsoid's
+// cross-section at that height (a tree crown the robot passes under at its rim but not near the
+// trunk). 0 when nothing of it is below.
+double FootprintScaleBelow(const GardenObject& object, double clearance) {
+  if (object.base_height >= clearance) return 0.0;
+  if (object.shape != Shape::kEllipsoid) return 1.0;
+  const double c = object.size.z() / 2, centre = object.base_height + c;
+  if (clearance >= centre) return 1.0;
+  const double u = (centre - clearance) / c;
+  return std::sqrt(std::max(0.0, 1.0 - u * u));
+}
+
+bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point, double scale = 1.0) {
   const Eigen::Vector2d local = Eigen::Rotation2Dd(-object.yaw) * (point - object.position);
-  const Eigen::Vector2d half = object.size.head<2>() / 2;
+  const Eigen::Vector2d half = scale * object.size.head<2>() / 2;
   if (object.shape == Shape::kBox) return std::abs(local.x()) <= half.x() && std::abs(local.y()) <= half.y();
   return (local.x() / half.x()) * (local.x() / half.x()) + (local.y() / half.y()) * (local.y() / half.y()) <= 1.0;
 }
@@ -323,7 +336,8 @@ bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point) {
 
 const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance) {
   for (const auto& object : garden.objects) {
-    if (object.base_height < clearance && InFootprint(object, point)) return &object;
+    const double scale = FootprintScaleBelow(object, clearance);
+    if (scale > 0.0 && InFootprint(object, point, scale)) return &object;
   }
   return nullptr;
 }
@@ -336,7 +350,8 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
   const int rows = static_cast<int>(std::ceil(garden.size.y() / resolution));
   map.occupied = cv::Mat::zeros(rows, columns, CV_8U);
   for (const auto& object : garden.objects) {
-    if (object.base_height >= clearance) continue;
+    const double scale = FootprintScaleBelow(object, clearance);
+    if (scale <= 0.0) continue;
     std::vector<cv::Point> polygon;
     if (object.shape == Shape::kBox) {
       for (const auto& corner : FootprintCorners(object.position, object.size.head<2>(), object.yaw)) {
@@ -345,7 +360,8 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
     } else {
       for (int i = 0; i < 48; ++i) {
         const double a = 2.0 * M_PI * i / 48;
-        const Eigen::Vector2d local(object.size.x() / 2 * std::cos(a), object.size.y() / 2 * std::sin(a));
+        const Eigen::Vector2d local(scale * object.size.x() / 2 * std::cos(a),
+                                    scale * object.size.y() / 2 * std::sin(a));
         polygon.push_back(map.Cell(object.position + Eigen::Rotation2Dd(object.yaw) * local));
       }
     }

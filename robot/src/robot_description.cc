@@ -153,6 +153,35 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() cons
   return {low, high};
 }
 
+double RobotDescription::Top(const std::map<std::string, double>& joint_positions) const {
+  double top = -std::numeric_limits<double>::infinity();
+  std::vector<urdf::LinkSharedPtr> links;
+  model_->getLinks(links);
+  for (const auto& link : links) {
+    const Eigen::Isometry3d T_base_link = FramePose(link->name, joint_positions);
+    for (const auto& collision : link->collision_array) {
+      if (!collision || !collision->geometry) continue;
+      Eigen::Vector3d half = Eigen::Vector3d::Zero();
+      const urdf::Geometry& g = *collision->geometry;
+      if (g.type == urdf::Geometry::BOX) {
+        const auto& box = static_cast<const urdf::Box&>(g);
+        half = 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z);
+      } else if (g.type == urdf::Geometry::CYLINDER) {
+        const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
+        half = Eigen::Vector3d(cylinder.radius, cylinder.radius, 0.5 * cylinder.length);
+      } else if (g.type == urdf::Geometry::SPHERE) {
+        half = Eigen::Vector3d::Constant(static_cast<const urdf::Sphere&>(g).radius);
+      } else {
+        continue;
+      }
+      const Eigen::Isometry3d T = T_base_link * ToIsometry(collision->origin);
+      top = std::max(top, T.translation().z() + (T.linear().row(2).cwiseAbs() * half)(0));
+    }
+  }
+  if (!std::isfinite(top)) throw InputError(path_, "the robot has no collision geometry");
+  return top;
+}
+
 std::vector<std::string> RobotDescription::ArmJointNames() const {
   std::vector<std::string> names;
   for (int i = 0; i < 6; ++i) names.push_back(RobotFrames::ArmJoint(i));

@@ -13,14 +13,14 @@ namespace {
 
 // The garden as it is in the trials - its objects, the scenario's unmapped objects, foliage at the
 // conditions' growth - on the prior map's cells (for plots and clearance: what the robot's map lacks).
-garden::OccupancyMap TrueMap(const Scenario& scenario, const garden::Garden& built) {
+garden::OccupancyMap TrueMap(const Scenario& scenario, const garden::Garden& built, double clearance_height) {
   garden::Garden in_trials = built;
   in_trials.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
   as_grown.point_sigma = 0.0;  // the truth, not a survey
   as_grown.growth = scenario.setting.conditions.growth;
   return garden::MakeOccupancyMap(SurveyedGarden(in_trials, as_grown, scenario.source), scenario.map_resolution,
-                                  scenario.map_clearance_height);
+                                  clearance_height);
 }
 
 // Where each goal truly is: a point goal's position, a bush's true centre (the garden file's object).
@@ -50,8 +50,7 @@ std::string Named(const garden::GardenObject& object) {
 // Places the scenario names that cannot be: a start where the base's outline (the URDF's) overlaps
 // an object of the garden as it stands, a point goal outside the garden or inside an object.
 // InputError naming the scenario file, the start or goal, and the object.
-void CheckPlaces(const Scenario& scenario, const garden::Garden& garden, const ProjectPaths& paths) {
-  const double clearance = scenario.map_clearance_height;
+void CheckPlaces(const Scenario& scenario, const garden::Garden& garden, const ProjectPaths& paths, double clearance) {
   const Eigen::Vector2d low = garden.centre - garden.size / 2, high = garden.centre + garden.size / 2;
   const auto outside = [&](const Eigen::Vector2d& p) {
     return (p.array() < low.array()).any() || (p.array() > high.array()).any();
@@ -94,20 +93,21 @@ PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths) 
   // In the order the checks have always run, so that the first problem is the one reported.
   prepared.stack_parameters = StackParametersFor(scenario, paths);
   prepared.garden = LoadGarden(scenario.setting, paths);
+  const double clearance_height = MapClearanceHeight(scenario, paths);
   if (!scenario.arm_reach) {
     garden::Garden in_trials = prepared.garden;  // with the objects the survey missed
     in_trials.AddObjects(scenario.survey.unmapped_objects);
-    CheckPlaces(scenario, in_trials, paths);
+    CheckPlaces(scenario, in_trials, paths, clearance_height);
   }
   prepared.surveyed = SurveyedGarden(prepared.garden, scenario.survey, scenario.source);
-  prepared.prior_map = PriorMap(scenario, prepared.surveyed);
+  prepared.prior_map = PriorMap(scenario, prepared.surveyed, clearance_height);
   prepared.mission = MissionGoals(scenario, prepared.surveyed);
   if (scenario.arm_reach) {
     BushOf(prepared.garden, scenario.arm_reach->bush, scenario,
            "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
   }
   prepared.goal_truths = GoalTruths(scenario, prepared.garden);
-  prepared.true_map = TrueMap(scenario, prepared.garden);
+  prepared.true_map = TrueMap(scenario, prepared.garden, clearance_height);
   return prepared;
 }
 

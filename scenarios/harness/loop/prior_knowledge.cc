@@ -11,7 +11,9 @@
 #include "trimbot/garden/conditions.h"
 #include "trimbot/garden/garden_tools.h"
 #include "trimbot/robot/camera_rig.h"
+#include "trimbot/robot/robot_description.h"
 #include "trimbot/robot/robot_files.h"
+#include "trimbot/robot/robot_parameters.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -64,8 +66,24 @@ garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey,
   return surveyed;
 }
 
-garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed) {
-  return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, scenario.map_clearance_height);
+double MapClearanceHeight(const Scenario& scenario, const ProjectPaths& paths) {
+  return scenario.map_clearance_height ? *scenario.map_clearance_height : RobotClearanceHeight(paths);
+}
+
+double RobotClearanceHeight(const ProjectPaths& paths) {
+  const robot::RobotFiles files = paths.robot_files();
+  const robot::RobotDescription description = robot::RobotDescription::Load(files.urdf);
+  const robot::RobotParameters parameters = robot::RobotParameters::Load(files.robot_parameters);
+  std::map<std::string, double> home;
+  for (int i = 0; i < static_cast<int>(parameters.arm_home_position.size()); ++i) {
+    home[robot::RobotFrames::ArmJoint(i)] = parameters.arm_home_position[static_cast<std::size_t>(i)];
+  }
+  constexpr double kMargin = 0.05;  // m between the robot's top and a crown it passes under
+  return description.Top(home) + kMargin;
+}
+
+garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed, double clearance_height) {
+  return garden::MakeOccupancyMap(surveyed, scenario.map_resolution, clearance_height);
 }
 
 std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir) {

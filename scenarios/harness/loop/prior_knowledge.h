@@ -21,8 +21,14 @@ namespace trimbot::scenarios {
 // still in (as the scenario gives them). Throws InputError (naming the scenario) for an unknown id.
 garden::Garden SurveyedGarden(const garden::Garden& built, const Survey& survey, const std::string& scenario_file);
 
-// The robot's prior map: the surveyed garden's objects below the scenario's clearance height.
-garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed);
+// The height below which objects are obstacles: the scenario's `map: clearance_height`, or else the
+// robot's top with its arm at home (URDF, robot_parameters.yaml) plus 5 cm - what passes under a
+// tree crown and what does not.
+double MapClearanceHeight(const Scenario& scenario, const ProjectPaths& paths);
+// The robot's top with its arm at home plus 5 cm (the default of MapClearanceHeight).
+double RobotClearanceHeight(const ProjectPaths& paths);
+// The robot's prior map: the surveyed garden's objects' parts below `clearance_height`.
+garden::OccupancyMap PriorMap(const Scenario& scenario, const garden::Garden& surveyed, double clearance_height);
 // Writes it (map_server) as <dir>/map.{png,yaml}; returns the YAML's path.
 std::string WritePriorMap(const garden::OccupancyMap& map, const std::string& dir);
 

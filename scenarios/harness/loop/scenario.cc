@@ -127,7 +127,7 @@ void ReadMission(const YamlMap& root, Scenario& s) {
   if (root.Has("map")) {
     const YamlMap map = root.Map("map");
     s.map_resolution = map.NumberOr("resolution", s.map_resolution, 0.005, 1.0, "m");
-    s.map_clearance_height = map.NumberOr("clearance_height", s.map_clearance_height, 0.0, 10.0, "m");
+    if (map.Has("clearance_height")) s.map_clearance_height = map.Number("clearance_height", 0.0, 10.0, "m");
     map.RejectUnknownKeys();
   }
   s.survey.seed = s.setting.seed;

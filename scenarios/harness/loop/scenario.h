@@ -97,9 +97,11 @@ struct Scenario {
   std::string source;  // file it was read from
   std::string name;
   std::string description;
-  Setting setting;                    // setting.seed is the batch seed; trial i runs with seed + i
-  double map_resolution = 0.05;       // m: the robot's prior map, made from the surveyed garden
-  double map_clearance_height = 1.0;  // m: objects whose lowest point is higher are not obstacles
+  Setting setting;               // setting.seed is the batch seed; trial i runs with seed + i
+  double map_resolution = 0.05;  // m: the robot's prior map, made from the surveyed garden
+  // m: the prior map holds each object's part below this height (a tree crown's cross-section
+  // there); unset: the robot's top with its arm at home (the URDF) plus 5 cm (MapClearanceHeight).
+  std::optional<double> map_clearance_height;
   Survey survey;
   std::vector<ScenarioGoal> goals;  // in order (none in an arm_reach scenario)
   std::optional<ArmReach> arm_reach;

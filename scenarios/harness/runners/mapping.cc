@@ -225,7 +225,8 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   drive->believed_start = BelievedStart(scenario, drive->setting.seed);
   drive->robot->SetInitialPose(0.0, drive->believed_start);
   drive->surveyed = SurveyedGarden(LoadGarden(scenario.setting, options.paths), scenario.survey, scenario.source);
-  drive->robot->SetMap(WritePriorMap(PriorMap(scenario, drive->surveyed), options.out_dir + "/prior_map"));
+  drive->robot->SetMap(WritePriorMap(PriorMap(scenario, drive->surveyed, MapClearanceHeight(scenario, options.paths)),
+                                     options.out_dir + "/prior_map"));
   drive->robot->SetGoals(MissionGoals(scenario, drive->surveyed));
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
     drive->fixes.emplace(scenario.simulated_pose_fixes, drive->setting.seed);

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "evaluation/trial_result.h"
+#include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "reports/batch_report.h"
 #include "runners/batch.h"
@@ -192,9 +193,9 @@ std::string TrialFailure(const TrialResult& trial) {
 
 }  // namespace
 
-SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double min_distance, double start_distance, int goals,
-                             std::uint64_t seed, const std::string& what) {
-  const garden::OccupancyMap map = garden::MakeOccupancyMap(garden, 0.05, 1.0);
+SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_height, double min_distance,
+                             double start_distance, int goals, std::uint64_t seed, const std::string& what) {
+  const garden::OccupancyMap map = garden::MakeOccupancyMap(garden, 0.05, clearance_height);
   // Distance of each free cell's centre to the nearest occupied cell (the map's edge counts as one).
   cv::Mat free = 255 - map.occupied;
   cv::Mat padded;
@@ -384,6 +385,7 @@ int RunSuite(const SuiteOptions& options) {
     for (const double y : {outline_min.y(), outline_max.y()}) reach = std::max(reach, std::hypot(x, y));
   }
   const double start_distance = reach + spec.goal_margin;
+  const double clearance_height = RobotClearanceHeight(options.paths);
   const std::string out = fs::absolute(options.out_dir).lexically_normal().string();
   fs::create_directories(out + "/gardens");
   SuiteTally tally;
@@ -394,8 +396,8 @@ int RunSuite(const SuiteOptions& options) {
     const garden::GeneratorParameters parameters = DrawGarden(spec, seed);
     const garden::Garden garden = garden::GenerateGarden(parameters);
     WriteFileAtomically(dir + "/garden.yaml", garden.ToYaml());
-    const SuiteLayout layout =
-        PlaceSuiteLayout(garden, min_distance, start_distance, spec.goals, seed, dir + "/garden.yaml");
+    const SuiteLayout layout = PlaceSuiteLayout(garden, clearance_height, min_distance, start_distance, spec.goals,
+                                                seed, dir + "/garden.yaml");
     WriteScenario(spec, g, dir + "/garden.yaml", layout, dir + "/scenario.yaml");
     const int code = RunGarden(options, dir + "/scenario.yaml", dir + "/batch");
     if (code != 0 && code != 1) {

@@ -47,14 +47,14 @@ struct SuiteLayout {
 };
 
 // Start and `goals` goals drawn uniformly (seeded) from the cells of `garden`'s occupancy map
-// (resolution 0.05 m, objects lower than 1 m) whose distance to the nearest obstacle is at least
+// (resolution 0.05 m, objects' parts below `clearance_height`) whose distance to the nearest obstacle is at least
 // `min_distance`, in the largest connected region of them (inside the fence); the start's heading
 // uniform. Throws InputError naming `what` when no cell
 // qualifies.
 // The start is drawn the same way from the cells at least `start_distance` from every obstacle (the
 // outline's reach plus the margin: the base fits there at any heading).
-SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double min_distance, double start_distance, int goals,
-                             std::uint64_t seed, const std::string& what);
+SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_height, double min_distance,
+                             double start_distance, int goals, std::uint64_t seed, const std::string& what);
 
 // Runs the suite and writes its reports; returns the exit code (1 when a suite criterion fails).
 // Bad input throws InputError naming the file and key.

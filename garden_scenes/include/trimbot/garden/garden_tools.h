@@ -44,11 +44,12 @@ struct OccupancyMap {
   // Cell (column, row) holding a map point.
   cv::Point Cell(const Eigen::Vector2d& point) const;
 };
-// The first object whose footprint holds `point` and whose lowest point is below `clearance` (what
-// the robot can run into there), or null.
+// The first object whose part below `clearance` covers `point` (what the robot can run into there;
+// an ellipsoid crown by its cross-section at that height), or null.
 const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance);
-// Footprints of every object whose lowest point is below `clearance` (tree crowns higher than the
-// robot are not obstacles to it; their trunks are).
+// Footprints of every object's part below `clearance`, the robot's height (tree crowns higher than
+// the robot are not obstacles to it, their trunks are; a crown lower than it is, by its
+// cross-section at that height).
 OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance);
 // Writes <dir>/<name>.png and <dir>/<name>.yaml in ROS map_server format.
 void WriteOccupancyMap(const OccupancyMap& map, const std::string& dir, const std::string& name);

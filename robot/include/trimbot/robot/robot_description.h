@@ -47,6 +47,9 @@ class RobotDescription {
   // geometry of base_link and the wheels (what touches a bush or an obstacle first; the ring and
   // the arm at rest stand within it).
   std::pair<Eigen::Vector2d, Eigen::Vector2d> BaseOutline() const;
+  // The highest point of the robot's collision geometry above base_link with the joints at these
+  // positions (the bounding boxes of boxes, cylinders and spheres): what passes under a tree crown.
+  double Top(const std::map<std::string, double>& joint_positions = {}) const;
 
  private:
   std::string path_;
