@@ -310,12 +310,6 @@ cv::Point OccupancyMap::Cell(const Eigen::Vector2d& point) const {
   return {column, occupied.rows - 1 - row_from_bottom};
 }
 
-namespace {
-
-// How much of an object's footprint its part below `clearance` covers: all of it for boxes and
-// cylinders (upright prisms) and for ellipsoids reaching their widest below it, else the ellipsoid's
-// cross-section at that height (a tree crown the robot passes under at its rim but not near the
-// trunk). 0 when nothing of it is below.
 double FootprintScaleBelow(const GardenObject& object, double clearance) {
   if (object.base_height >= clearance) return 0.0;
   if (object.shape != Shape::kEllipsoid) return 1.0;
@@ -324,6 +318,8 @@ double FootprintScaleBelow(const GardenObject& object, double clearance) {
   const double u = (centre - clearance) / c;
   return std::sqrt(std::max(0.0, 1.0 - u * u));
 }
+
+namespace {
 
 bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point, double scale = 1.0) {
   const Eigen::Vector2d local = Eigen::Rotation2Dd(-object.yaw) * (point - object.position);
@@ -342,6 +338,36 @@ const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point,
   return nullptr;
 }
 
+namespace {
+
+Eigen::Vector2d CellCentre(const OccupancyMap& map, int column, int row) {
+  return map.origin + map.resolution * Eigen::Vector2d(column + 0.5, map.occupied.rows - 1 - row + 0.5);
+}
+
+// Marks the cells whose centre lies in the object's footprint (scaled by `scale`): the occupied
+// squares neither grow nor shrink a footprint on average, where marking every cell a footprint
+// touches grows each object by half a cell, up to a whole one, all round (5 cm of the 10 cm a side
+// that a gap 0.2 m wider than the base leaves). Margins for a survey's errors are the planner's
+// (its clearance wall and cost), not the map's. A band narrower than a cell's diagonal can fall
+// between the cells' centres, so an object that thin (a fence) gets the line of cells along its
+// longer axis instead.
+void MarkFootprint(const GardenObject& object, double scale, OccupancyMap& map) {
+  const Eigen::Vector2d half = scale * object.size.head<2>() / 2;
+  const Eigen::Vector2d reach = Eigen::Vector2d::Constant(half.norm());
+  const cv::Point low = map.Cell(object.position - reach), high = map.Cell(object.position + reach);
+  for (int row = std::max(0, high.y); row <= std::min(map.occupied.rows - 1, low.y); ++row) {
+    for (int column = std::max(0, low.x); column <= std::min(map.occupied.cols - 1, high.x); ++column) {
+      if (InFootprint(object, CellCentre(map, column, row), scale)) map.occupied.at<uchar>(row, column) = 255;
+    }
+  }
+  if (2.0 * half.minCoeff() >= std::sqrt(2.0) * map.resolution) return;
+  const Eigen::Vector2d axis = Eigen::Rotation2Dd(object.yaw) * (half.x() >= half.y() ? Eigen::Vector2d(half.x(), 0.0)
+                                                                                      : Eigen::Vector2d(0.0, half.y()));
+  cv::line(map.occupied, map.Cell(object.position - axis), map.Cell(object.position + axis), cv::Scalar(255));
+}
+
+}  // namespace
+
 OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double clearance) {
   OccupancyMap map;
   map.resolution = resolution;
@@ -351,25 +377,7 @@ OccupancyMap MakeOccupancyMap(const Garden& garden, double resolution, double cl
   map.occupied = cv::Mat::zeros(rows, columns, CV_8U);
   for (const auto& object : garden.objects) {
     const double scale = FootprintScaleBelow(object, clearance);
-    if (scale <= 0.0) continue;
-    std::vector<cv::Point> polygon;
-    if (object.shape == Shape::kBox) {
-      for (const auto& corner : FootprintCorners(object.position, object.size.head<2>(), object.yaw)) {
-        polygon.push_back(map.Cell(corner));
-      }
-    } else {
-      for (int i = 0; i < 48; ++i) {
-        const double a = 2.0 * M_PI * i / 48;
-        const Eigen::Vector2d local(scale * object.size.x() / 2 * std::cos(a),
-                                    scale * object.size.y() / 2 * std::sin(a));
-        polygon.push_back(map.Cell(object.position + Eigen::Rotation2Dd(object.yaw) * local));
-      }
-    }
-    // Every cell the footprint touches: objects grow by up to a cell all round, a margin the
-    // planner's 5 cm wall relies on today (a survey is a few centimetres off, the base passes
-    // under tree crowns hanging near the map's clearance height). See docs/design.md.
-    cv::fillConvexPoly(map.occupied, polygon, cv::Scalar(255));
-    cv::polylines(map.occupied, polygon, true, cv::Scalar(255));  // thin objects keep at least one cell
+    if (scale > 0.0) MarkFootprint(object, scale, map);
   }
   return map;
 }

@@ -44,6 +44,11 @@ struct OccupancyMap {
   // Cell (column, row) holding a map point.
   cv::Point Cell(const Eigen::Vector2d& point) const;
 };
+// How much of an object's footprint its part below `clearance` covers (a scale of its size): all of
+// it for boxes and cylinders (upright prisms) and for ellipsoids reaching their widest below it,
+// else the ellipsoid's cross-section at that height (a tree crown the robot passes under at its rim
+// but not near the trunk). 0 when nothing of it is below.
+double FootprintScaleBelow(const GardenObject& object, double clearance);
 // The first object whose part below `clearance` covers `point` (what the robot can run into there;
 // an ellipsoid crown by its cross-section at that height), or null.
 const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance);
