@@ -361,8 +361,8 @@ void MarkFootprint(const GardenObject& object, double scale, OccupancyMap& map) 
     }
   }
   if (2.0 * half.minCoeff() >= std::sqrt(2.0) * map.resolution) return;
-  const Eigen::Vector2d axis = Eigen::Rotation2Dd(object.yaw) * (half.x() >= half.y() ? Eigen::Vector2d(half.x(), 0.0)
-                                                                                      : Eigen::Vector2d(0.0, half.y()));
+  const Eigen::Vector2d axis = Eigen::Rotation2Dd(object.yaw) *
+                               (half.x() >= half.y() ? Eigen::Vector2d(half.x(), 0.0) : Eigen::Vector2d(0.0, half.y()));
   cv::line(map.occupied, map.Cell(object.position - axis), map.Cell(object.position + axis), cv::Scalar(255));
 }
 
