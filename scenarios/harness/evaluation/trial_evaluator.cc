@@ -161,12 +161,15 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
 
 void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& true_map, const Eigen::Vector2d& outline_min,
                                       const Eigen::Vector2d& outline_max) {
-  // Signed distance: in free cells to the nearest occupied one, in occupied cells minus the
-  // distance to the nearest free one (cells outside the map: unknown).
-  cv::Mat free = true_map.occupied == 0, inside;
+  // Signed distance to the objects' surfaces: in free cells to the nearest occupied one, in occupied
+  // cells minus the distance to the nearest free one (cells outside the map: unknown); between
+  // cell centres, so half a cell less (more inside): a cell is occupied when its centre lies in a
+  // footprint, so the surface lies half a cell from the last occupied centre, on average.
+  cv::Mat free = true_map.occupied == 0, inside, side;
   cv::distanceTransform(free, obstacle_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  obstacle_distance_ = (obstacle_distance_ - inside) * true_map.resolution;
+  free.convertTo(side, CV_32F, 1.0 / 255.0, -0.5);  // +0.5 in free cells, -0.5 in occupied ones
+  obstacle_distance_ = (obstacle_distance_ - inside - side) * true_map.resolution;
   true_map_ = true_map;
   // The outline's perimeter every ~2 cm.
   outline_.clear();

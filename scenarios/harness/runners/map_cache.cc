@@ -1,5 +1,7 @@
 #include "runners/map_cache.h"
 
+#include "mapping_run_sources.h"  // generated: TRIMBOT_MAPPING_RUN_SOURCES
+
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/wait.h>
@@ -196,8 +198,12 @@ std::string MapCacheKey(const MapRecipe& recipe, const ProjectPaths& paths) {
         << Number(e.wheel_slip_fraction) << " " << Number(e.wheel_scale_sigma) << " "
         << Number(e.wheel_scale_random_walk) << " " << Number(e.gyro_sigma) << "\n";
   }
-  // A scenario as the mapping drive is driven by the stack: all of its parameters count then.
-  if (plan.Has("goals")) key << "stack parameters " << Hex(Fnv1a(YamlContent(robot.stack_parameters))) << "\n";
+  // A scenario as the mapping drive is driven by the stack: all of its parameters count then, and
+  // its code (where the drive goes, and so the map, changes with the planner or the simulator).
+  if (plan.Has("goals")) {
+    key << "stack parameters " << Hex(Fnv1a(YamlContent(robot.stack_parameters))) << "\n"
+        << "mapping run sources " << TRIMBOT_MAPPING_RUN_SOURCES << "\n";
+  }
   key << "seed " << (recipe.seed ? std::to_string(*recipe.seed) : "the plan's") << "\n"
       << "seconds " << (recipe.seconds ? Number(*recipe.seconds) : "the whole drive") << "\n"
       << BuilderSettings(MapBuilderOptionsFor(recipe, *recipe.descriptor));

@@ -9,8 +9,10 @@
 // generator's), the mapping drive plan, the garden file, the robot files the rendering and the
 // map builder read (URDF, camera calibration, robot parameters), the descriptor, the drive's seed
 // and length, the survey noise and the map builder's settings. YAML files enter as their parsed
-// content (comments and layout do not count), the URDF as its bytes. Nothing else: a change of the
-// navigation parameters or of the trials' scenario does not rebuild the map.
+// content (comments and layout do not count), the URDF as its bytes. A scenario as the mapping
+// drive is driven by the stack, so its map also depends on stack.yaml and on the code (a hash of
+// the stack's, the simulator's and the trial loop's sources, cmake/SourceFingerprint.cmake); a
+// drive plan's map does not. Nothing else: a change of the trials' scenario does not rebuild it.
 //
 // Cache folder: $TRIMBOT_MAP_CACHE, else $XDG_CACHE_HOME/trimbot/maps, else ~/.cache/trimbot/maps.
 // On a cluster it must be a folder every node sees. Builds are serialized by a lock file per key

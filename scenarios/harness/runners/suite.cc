@@ -196,7 +196,9 @@ std::string TrialFailure(const TrialResult& trial) {
 SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_height, double min_distance,
                              double start_distance, int goals, std::uint64_t seed, const std::string& what) {
   const garden::OccupancyMap map = garden::MakeOccupancyMap(garden, 0.05, clearance_height);
-  // Distance of each free cell's centre to the nearest occupied cell (the map's edge counts as one).
+  // Distance of each free cell's centre to the nearest occupied cell's square (the map's edge counts
+  // as one): to its centre, less half a cell. The map's cells are those whose centre lies in a
+  // footprint, so a square's edge is where the footprint's is, on average.
   cv::Mat free = 255 - map.occupied;
   cv::Mat padded;
   cv::copyMakeBorder(free, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
@@ -205,7 +207,9 @@ SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_heig
   cv::Mat far_enough(map.occupied.size(), CV_8U, cv::Scalar(0));
   for (int r = 0; r < map.occupied.rows; ++r) {
     for (int c = 0; c < map.occupied.cols; ++c) {
-      if (distance.at<float>(r + 1, c + 1) * map.resolution >= min_distance) far_enough.at<std::uint8_t>(r, c) = 255;
+      if ((distance.at<float>(r + 1, c + 1) - 0.5) * map.resolution >= min_distance) {
+        far_enough.at<std::uint8_t>(r, c) = 255;
+      }
     }
   }
   // The largest connected region of such cells: the garden inside its fence, not the strip outside
@@ -224,7 +228,7 @@ SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_heig
     for (int c = 0; c < labels.cols; ++c) {
       if (far_enough.at<std::uint8_t>(r, c) == 0 || labels.at<int>(r, c) != largest) continue;
       cells.emplace_back(c, r);
-      if (distance.at<float>(r + 1, c + 1) * map.resolution >= start_distance) start_cells.emplace_back(c, r);
+      if ((distance.at<float>(r + 1, c + 1) - 0.5) * map.resolution >= start_distance) start_cells.emplace_back(c, r);
     }
   }
   if (cells.empty() || start_cells.empty()) {

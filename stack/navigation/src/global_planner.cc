@@ -193,7 +193,9 @@ std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen:
 // Whether the base can turn all the way round at `pose`: the disc its farthest corner sweeps keeps
 // min_clearance (exact for a full turn, conservative for part of one).
 bool CanTurnRound(const GlobalPlanner& planner, const Pose2& pose) {
-  return planner.map().DistanceToObstacle({pose.x, pose.y}) >=
+  // The distance is to the nearest occupied cell's centre; its square reaches half a diagonal nearer.
+  const OccupancyGrid& map = planner.map();
+  return map.DistanceToObstacle({pose.x, pose.y}) - M_SQRT1_2 * map.resolution() >=
          planner.outline().reach() + planner.parameters().min_clearance;
 }
 
@@ -319,13 +321,15 @@ std::vector<Eigen::Vector2d> RouteCells(const GlobalPlanner& planner, const Clea
   if (!inside(from) || !inside(to)) return {};
   // Near the start (after a stop the robot may stand closer than min_clearance) a cell need only
   // be no closer than the start's.
-  const double at_start = map.DistanceToObstacleAtCell(map.CellCentre(from)) - half_width;
+  // Distances between cell centres; the occupied cell's square reaches half a cell nearer.
+  const double to_square = 0.5 * map.resolution();
+  const double at_start = map.DistanceToObstacleAtCell(map.CellCentre(from)) - to_square - half_width;
   std::vector<double> clearance(static_cast<std::size_t>(rows) * cols);
   std::vector<char> free(clearance.size(), 0);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       const Eigen::Vector2d centre = map.CellCentre({c, r});
-      const double d = map.DistanceToObstacleAtCell(centre) - half_width;
+      const double d = map.DistanceToObstacleAtCell(centre) - to_square - half_width;
       const bool near_start = (centre - Eigen::Vector2d(start.x, start.y)).norm() < parameters.start_free_radius;
       clearance[index(r, c)] = d;
       free[index(r, c)] = d >= (near_start ? std::min(rule.At(centre), at_start) : rule.At(centre)) ? 1 : 0;
@@ -381,32 +385,56 @@ std::vector<Eigen::Vector2d> RouteCells(const GlobalPlanner& planner, const Clea
   return cells;
 }
 
-// RouteCells thinned to a vertex about every 0.4 m, each headed along its incoming step, then the
-// goal, and checked as the drive's motions with the whole outline. RRT* with a fixed number of
-// iterations can settle on the wrong side of a row of bushes, which no shortcutting undoes; this
-// route is the other candidate, and the cheaper valid one is kept. Empty when there is none.
+// RouteCells as the drive's motions: a vertex about every 0.4 m along the route, headed along its
+// incoming motion, then the goal, each motion checked with the whole outline. Where the next
+// vertex cannot be reached so (a narrow passage entered at an angle: a 0.7 m long base with 2 cm to
+// spare a side fits only within 3 degrees of its axis), the route is pulled taut there instead:
+// the farthest of its points within kPullReach that a motion reaches, which lines the base up
+// with the passage. RRT* with a fixed number of iterations can settle on the wrong side of a row of
+// bushes, which no shortcutting undoes, and rarely samples such a passage's narrow band of poses;
+// this route is the other candidate, and the cheaper valid one is kept. Empty when some vertex
+// reaches no point further on.
 std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& rule, const Pose2& start,
                              const Eigen::Vector2d& goal) {
-  const std::vector<Eigen::Vector2d> cells = RouteCells(planner, rule, start, goal);
-  if (cells.empty()) return {};
-  // A vertex about every 0.4 m, headed along its incoming step; then the goal.
+  std::vector<Eigen::Vector2d> points = RouteCells(planner, rule, start, goal);
+  if (points.empty()) return {};
+  if ((points.back() - goal).norm() > 1e-9) points.push_back(goal);
+  constexpr double kSpacing = 0.4;           // m between vertices where the motions are clear
+  constexpr double kPullReach = 4.0;         // m along the route: bounds the motions tried from a vertex
+  std::vector<double> along(points.size());  // m along the route from the start
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Eigen::Vector2d previous = k == 0 ? Eigen::Vector2d(start.x, start.y) : points[k - 1];
+    along[k] = (k == 0 ? 0.0 : along[k - 1]) + (points[k] - previous).norm();
+  }
+  // The motion from `from` to route point k, moved `side` metres square to the motion (the cells'
+  // centres lie up to half a cell off a passage's midline; a passage with 2 cm to spare needs better).
+  const auto motion_to = [&](const Pose2& from, std::size_t k, double side) {
+    const Eigen::Vector2d d = points[k] - Eigen::Vector2d(from.x, from.y);
+    const Eigen::Vector2d to = points[k] + side * Eigen::Vector2d(-d.y(), d.x()).normalized();
+    return Pose2{to.x(), to.y(), std::atan2(to.y() - from.y, to.x() - from.x)};
+  };
+  const double quarter = 0.25 * planner.map().resolution();
   std::vector<Pose2> poses{start};
-  double since = 0.0;
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    const Eigen::Vector2d previous = k == 0 ? Eigen::Vector2d(start.x, start.y) : cells[k - 1];
-    since += (cells[k] - previous).norm();
-    if (since < 0.4 && k + 1 < cells.size()) continue;
-    const Pose2& last = poses.back();
-    if (std::hypot(cells[k].x() - last.x, cells[k].y() - last.y) < 1e-9) continue;
-    poses.push_back({cells[k].x(), cells[k].y(), std::atan2(cells[k].y() - last.y, cells[k].x() - last.x)});
-    since = 0.0;
-  }
-  const Pose2& last = poses.back();
-  if (std::hypot(goal.x() - last.x, goal.y() - last.y) > 1e-9) {
-    poses.push_back({goal.x(), goal.y(), std::atan2(goal.y() - last.y, goal.x() - last.x)});
-  }
-  for (std::size_t k = 1; k < poses.size(); ++k) {
-    if (!MotionClear(planner, rule, poses[k - 1], poses[k])) return {};
+  double at = 0.0;       // m along the route of the last vertex
+  std::size_t next = 0;  // first point beyond it
+  while (next < points.size()) {
+    const Pose2 last = poses.back();
+    std::size_t spaced = next, farthest = next;
+    while (spaced + 1 < points.size() && along[spaced] - at < kSpacing) ++spaced;
+    while (farthest + 1 < points.size() && along[farthest + 1] - at <= kPullReach) ++farthest;
+    std::optional<std::pair<std::size_t, Pose2>> reached;
+    if (const Pose2 to = motion_to(last, spaced, 0.0); MotionClear(planner, rule, last, to)) reached = {spaced, to};
+    for (const double side : {0.0, quarter, -quarter, 2.0 * quarter, -2.0 * quarter}) {
+      for (std::size_t k = farthest + 1; !reached && k-- > next;) {
+        const bool is_goal = k + 1 == points.size();
+        if (is_goal && side != 0.0) continue;  // the goal stays where it is
+        if (const Pose2 to = motion_to(last, k, side); MotionClear(planner, rule, last, to)) reached = {k, to};
+      }
+    }
+    if (!reached) return {};
+    poses.push_back(reached->second);
+    at = along[reached->first];
+    next = reached->first + 1;
   }
   return poses;
 }
@@ -587,6 +615,21 @@ std::vector<Pose2> GridRouteToGoal(const GlobalPlanner& planner, const Clearance
   return route;
 }
 
+// The outline's smallest clearance driving straight from `from` to `to` (sampled every half cell),
+// at most preferred_clearance.
+double SegmentClearance(const GlobalPlanner& planner, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+  const double enough = planner.parameters().preferred_clearance;
+  const double length = (to - from).norm();
+  const double heading = length > 1e-9 ? std::atan2(to.y() - from.y(), to.x() - from.x()) : 0.0;
+  const int steps = std::max(1, static_cast<int>(std::ceil(length / (0.5 * planner.map().resolution()))));
+  double smallest = enough;
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Vector2d q = from + (static_cast<double>(k) / steps) * (to - from);
+    smallest = std::min(smallest, planner.Clearance({q.x(), q.y(), heading}, enough));
+  }
+  return smallest;
+}
+
 // The follower turns at each vertex from the incoming to the outgoing direction; the motions
 // checked turned through the vertex's own heading. Give the vertices their arrival headings and
 // keep that if it is still clear (it nearly always is).
@@ -659,6 +702,8 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   if (result.path.size() < 2) result.path.push_back(result.path.back());
   for (std::size_t i = 1; i < result.path.size(); ++i) result.length += (result.path[i] - result.path[i - 1]).norm();
   for (std::size_t i = 1; i < poses.size(); ++i) result.cost += MotionCost(poses[i - 1], poses[i]);
+  for (std::size_t i = 1; i < result.path.size(); ++i)
+    result.clearance.push_back(SegmentClearance(*this, result.path[i - 1], result.path[i]));
   result.found = true;
   return result;
 }

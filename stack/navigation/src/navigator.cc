@@ -167,7 +167,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
     }
     return;
   }
-  follower_.SetPath(plan.path);
+  follower_.SetPath(plan.path, plan.clearance);
   mode_ = Mode::kFollowing;
   Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m", active_goal_);
 }
@@ -239,10 +239,13 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
     return stop;
   }
   // Too close to an obstacle while moving towards it - driving forward, or turning on the spot,
-  // which sweeps the outline's front round (checked turn_check_angle ahead): stop and back off.
+  // which sweeps the outline's front round (checked turn_check_angle ahead, or where the turn
+  // ends if sooner: a small turn lining up in a narrow passage must not be stopped for what a
+  // bigger one would hit): stop and back off.
   const bool turning_in_place = follow.command.linear == 0.0 && follow.command.angular != 0.0;
   Pose2 turned = estimate;
-  turned.yaw += std::copysign(parameters_.turn_check_angle, follow.command.angular);
+  turned.yaw +=
+      std::copysign(std::min(parameters_.turn_check_angle, std::abs(follow.turn_left)), follow.command.angular);
   const bool too_close =
       (follow.command.linear > 0.0 &&
        OutlineClearance(estimate, parameters_.stop_clearance) < parameters_.stop_clearance) ||

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace trimbot::stack {
 namespace {
@@ -15,17 +16,35 @@ double Project(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::
 
 }  // namespace
 
+bool PathFollower::Exact(std::size_t s) const {
+  return s < clearance_.size() && clearance_[s] < parameters_.exact_below;
+}
+
 std::size_t PathFollower::StretchEnd(std::size_t segment) const {
   for (std::size_t v = segment + 1; v + 1 < path_.size(); ++v) {
     const Eigen::Vector2d in = path_[v] - path_[v - 1], out = path_[v + 1] - path_[v];
     const double turn = std::abs(std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out)));
     if (turn > parameters_.sharp_turn) return v;
+    if ((Exact(v - 1) || Exact(v)) && turn > parameters_.exact_align_tolerance) return v;
   }
   return path_.empty() ? 0 : path_.size() - 1;
 }
 
-void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path) {
+bool PathFollower::Reached(std::size_t v, const Eigen::Vector2d& position) const {
+  const double distance = (path_[v] - position).norm();
+  if (!Exact(v - 1) && !Exact(v)) return distance < parameters_.vertex_tolerance;
+  // Along the incoming segment: the turn on the spot there is what the plan checked.
+  const Eigen::Vector2d in = path_[v] - path_[v - 1];
+  const double to_go = in.norm() > 0.0 ? (path_[v] - position).dot(in) / in.norm() : 0.0;
+  return distance < parameters_.vertex_tolerance && to_go < parameters_.exact_vertex_tolerance;
+}
+
+void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& clearance) {
+  if (!clearance.empty() && clearance.size() + 1 != path.size()) {
+    throw std::invalid_argument("PathFollower::SetPath: one clearance per segment of the path");
+  }
   path_ = path;
+  clearance_ = clearance;
   segment_ = 0;
   aligned_ = false;
 }
@@ -61,7 +80,7 @@ FollowerOutput PathFollower::Update(const Pose2& pose) {
   // A sharp vertex ends the current stretch: the robot drives to it and turns on the spot there
   // instead of cutting the corner (the planner checked the footprint along the segments only).
   std::size_t stretch_end = StretchEnd(segment_);
-  while (stretch_end + 1 < path_.size() && (path_[stretch_end] - position).norm() < parameters_.vertex_tolerance) {
+  while (stretch_end + 1 < path_.size() && Reached(stretch_end, position)) {
     segment_ = stretch_end;
     aligned_ = false;
     stretch_end = StretchEnd(segment_);
@@ -95,9 +114,11 @@ FollowerOutput PathFollower::Update(const Pose2& pose) {
   const double heading_error = std::atan2(ly, lx);
 
   const double w_max = parameters_.max_angular_speed;
-  if (!aligned_ && std::abs(heading_error) <= parameters_.align_tolerance) aligned_ = true;
+  const double align = Exact(segment_) ? parameters_.exact_align_tolerance : parameters_.align_tolerance;
+  if (!aligned_ && std::abs(heading_error) <= align) aligned_ = true;
   if (!aligned_ || std::abs(heading_error) > parameters_.turn_in_place_above) {
     out.command.angular = std::clamp(parameters_.heading_gain * heading_error, -w_max, w_max);
+    out.turn_left = heading_error;
     return out;
   }
   // Pure pursuit: the arc through the target has curvature 2 * ly / d^2.

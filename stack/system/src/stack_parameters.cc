@@ -114,6 +114,9 @@ void ReadFollower(Reader& r, FollowerParameters& p) {
   r.Number("goal_tolerance", &p.goal_tolerance, 0.001, 2.0, "m");
   r.Number("slow_down_distance", &p.slow_down_distance, 0.0, 10.0, "m");
   r.Number("min_speed", &p.min_speed, 0.001, 0.6, "m/s");
+  r.Number("exact_below", &p.exact_below, 0.0, 10.0, "m");
+  r.Number("exact_align_tolerance", &p.exact_align_tolerance, 0.001, M_PI, "rad");
+  r.Number("exact_vertex_tolerance", &p.exact_vertex_tolerance, 0.001, 1.0, "m");
 }
 
 void ReadNavigation(Reader& r, StackParameters& s) {

@@ -42,9 +42,12 @@ struct PlannerParameters {
 struct PlanResult {
   bool found = false;
   std::vector<Eigen::Vector2d> path;  // map frame, from the start to the goal
-  double length = 0.0;                // m
-  double cost = 0.0;                  // m: length plus the turns' and the clearance's costs
-  std::string message;                // why no path was found
+  // Per segment (path[i] to path[i + 1]): the outline's smallest clearance driving along it, at
+  // most preferred_clearance (what the follower needs to know: where to drive exactly as planned).
+  std::vector<double> clearance;
+  double length = 0.0;  // m
+  double cost = 0.0;    // m: length plus the turns' and the clearance's costs
+  std::string message;  // why no path was found
 };
 
 // Seeds OMPL's random numbers for this process. Call once, before the first plan (OMPL seeds each
