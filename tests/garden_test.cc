@@ -276,9 +276,7 @@ TEST(OccupancyMap, MarksEveryFootprintBelowTheClearance) {
   }
   for (int row = 0; row < map.occupied.rows; ++row) {
     for (int column = 0; column < map.occupied.cols; ++column) {
-      const Eigen::Vector2d centre =
-          map.origin + map.resolution * Eigen::Vector2d(column + 0.5, map.occupied.rows - 1 - row + 0.5);
-      if (ObjectAt(garden, centre, clearance) != nullptr) {
+      if (ObjectAt(garden, map.CellCentre({column, row}), clearance) != nullptr) {
         ASSERT_EQ(map.occupied.at<uchar>(row, column), 255) << "cell " << column << ", " << row;
       }
     }

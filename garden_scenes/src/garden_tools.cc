@@ -310,6 +310,10 @@ cv::Point OccupancyMap::Cell(const Eigen::Vector2d& point) const {
   return {column, occupied.rows - 1 - row_from_bottom};
 }
 
+Eigen::Vector2d OccupancyMap::CellCentre(const cv::Point& cell) const {
+  return origin + resolution * Eigen::Vector2d(cell.x + 0.5, occupied.rows - 1 - cell.y + 0.5);
+}
+
 double FootprintScaleBelow(const GardenObject& object, double clearance) {
   if (object.base_height >= clearance) return 0.0;
   if (object.shape != Shape::kEllipsoid) return 1.0;
@@ -340,10 +344,6 @@ const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point,
 
 namespace {
 
-Eigen::Vector2d CellCentre(const OccupancyMap& map, int column, int row) {
-  return map.origin + map.resolution * Eigen::Vector2d(column + 0.5, map.occupied.rows - 1 - row + 0.5);
-}
-
 // Marks the cells whose centre lies in the object's footprint (scaled by `scale`): the occupied
 // squares neither grow nor shrink a footprint on average, where marking every cell a footprint
 // touches grows each object by half a cell, up to a whole one, all round (5 cm of the 10 cm a side
@@ -357,7 +357,7 @@ void MarkFootprint(const GardenObject& object, double scale, OccupancyMap& map) 
   const cv::Point low = map.Cell(object.position - reach), high = map.Cell(object.position + reach);
   for (int row = std::max(0, high.y); row <= std::min(map.occupied.rows - 1, low.y); ++row) {
     for (int column = std::max(0, low.x); column <= std::min(map.occupied.cols - 1, high.x); ++column) {
-      if (InFootprint(object, CellCentre(map, column, row), scale)) map.occupied.at<uchar>(row, column) = 255;
+      if (InFootprint(object, map.CellCentre({column, row}), scale)) map.occupied.at<uchar>(row, column) = 255;
     }
   }
   if (2.0 * half.minCoeff() >= std::sqrt(2.0) * map.resolution) return;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <mutex>
+#include <optional>
 
 #include "trimbot/common/input_error.h"
 
@@ -24,6 +25,21 @@ class CollectingHandler : public console_bridge::OutputHandler {
 };
 
 std::mutex parse_mutex;  // console_bridge's handler is global
+
+// Half extents of a collision geometry's own bounding box (boxes, cylinders, spheres; none for
+// meshes, which the robot's collision model does not use).
+std::optional<Eigen::Vector3d> HalfExtents(const urdf::Geometry& g) {
+  if (g.type == urdf::Geometry::BOX) {
+    const auto& box = static_cast<const urdf::Box&>(g);
+    return 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z);
+  }
+  if (g.type == urdf::Geometry::CYLINDER) {
+    const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
+    return Eigen::Vector3d(cylinder.radius, cylinder.radius, 0.5 * cylinder.length);
+  }
+  if (g.type == urdf::Geometry::SPHERE) return Eigen::Vector3d::Constant(static_cast<const urdf::Sphere&>(g).radius);
+  return std::nullopt;
+}
 
 }  // namespace
 
@@ -125,20 +141,9 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() cons
     const Eigen::Isometry3d T_base_link = FramePose(name);
     for (const auto& collision : link->collision_array) {
       if (!collision || !collision->geometry) continue;
-      // Half extents of the geometry's own bounding box.
-      Eigen::Vector3d half = Eigen::Vector3d::Zero();
-      const urdf::Geometry& g = *collision->geometry;
-      if (g.type == urdf::Geometry::BOX) {
-        const auto& box = static_cast<const urdf::Box&>(g);
-        half = 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z);
-      } else if (g.type == urdf::Geometry::CYLINDER) {
-        const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
-        half = Eigen::Vector3d(cylinder.radius, cylinder.radius, 0.5 * cylinder.length);
-      } else if (g.type == urdf::Geometry::SPHERE) {
-        half = Eigen::Vector3d::Constant(static_cast<const urdf::Sphere&>(g).radius);
-      } else {
-        continue;
-      }
+      const std::optional<Eigen::Vector3d> extents = HalfExtents(*collision->geometry);
+      if (!extents) continue;
+      const Eigen::Vector3d& half = *extents;
       const Eigen::Isometry3d T = T_base_link * ToIsometry(collision->origin);
       for (int corner = 0; corner < 8; ++corner) {
         const Eigen::Vector3d local((corner & 1 ? 1 : -1) * half.x(), (corner & 2 ? 1 : -1) * half.y(),
@@ -161,19 +166,9 @@ double RobotDescription::Top(const std::map<std::string, double>& joint_position
     const Eigen::Isometry3d T_base_link = FramePose(link->name, joint_positions);
     for (const auto& collision : link->collision_array) {
       if (!collision || !collision->geometry) continue;
-      Eigen::Vector3d half = Eigen::Vector3d::Zero();
-      const urdf::Geometry& g = *collision->geometry;
-      if (g.type == urdf::Geometry::BOX) {
-        const auto& box = static_cast<const urdf::Box&>(g);
-        half = 0.5 * Eigen::Vector3d(box.dim.x, box.dim.y, box.dim.z);
-      } else if (g.type == urdf::Geometry::CYLINDER) {
-        const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
-        half = Eigen::Vector3d(cylinder.radius, cylinder.radius, 0.5 * cylinder.length);
-      } else if (g.type == urdf::Geometry::SPHERE) {
-        half = Eigen::Vector3d::Constant(static_cast<const urdf::Sphere&>(g).radius);
-      } else {
-        continue;
-      }
+      const std::optional<Eigen::Vector3d> extents = HalfExtents(*collision->geometry);
+      if (!extents) continue;
+      const Eigen::Vector3d& half = *extents;
       const Eigen::Isometry3d T = T_base_link * ToIsometry(collision->origin);
       top = std::max(top, T.translation().z() + (T.linear().row(2).cwiseAbs() * half)(0));
     }

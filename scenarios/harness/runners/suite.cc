@@ -239,8 +239,7 @@ SuiteLayout PlaceSuiteLayout(const garden::Garden& garden, double clearance_heig
   Rng rng = MakeRng(seed, "suite_layout");
   const auto draw = [&](const std::vector<cv::Point>& from) {
     const cv::Point cell = from[static_cast<std::size_t>(UniformUnit(rng) * from.size())];
-    return Eigen::Vector2d(map.origin.x() + (cell.x + 0.5) * map.resolution,
-                           map.origin.y() + (map.occupied.rows - 1 - cell.y + 0.5) * map.resolution);
+    return map.CellCentre(cell);
   };
   SuiteLayout layout;
   const Eigen::Vector2d start = draw(start_cells);

@@ -700,10 +700,11 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
     if (result.path.empty() || (point - result.path.back()).norm() > 1e-9) result.path.push_back(point);
   }
   if (result.path.size() < 2) result.path.push_back(result.path.back());
-  for (std::size_t i = 1; i < result.path.size(); ++i) result.length += (result.path[i] - result.path[i - 1]).norm();
-  for (std::size_t i = 1; i < poses.size(); ++i) result.cost += MotionCost(poses[i - 1], poses[i]);
-  for (std::size_t i = 1; i < result.path.size(); ++i)
+  for (std::size_t i = 1; i < result.path.size(); ++i) {
+    result.length += (result.path[i] - result.path[i - 1]).norm();
     result.clearance.push_back(SegmentClearance(*this, result.path[i - 1], result.path[i]));
+  }
+  result.cost = PathCost(*this, poses);
   result.found = true;
   return result;
 }

@@ -41,8 +41,9 @@ struct OccupancyMap {
   cv::Mat occupied;          // CV_8U, 255 = occupied, row 0 = the map's top (largest y)
   double resolution = 0.05;  // m per cell
   Eigen::Vector2d origin;    // map coordinates of the bottom-left corner of the bottom-left cell
-  // Cell (column, row) holding a map point.
+  // Cell (column, row) holding a map point, and the map point at a cell's centre.
   cv::Point Cell(const Eigen::Vector2d& point) const;
+  Eigen::Vector2d CellCentre(const cv::Point& cell) const;
 };
 // How much of an object's footprint its part below `clearance` covers (a scale of its size): all of
 // it for boxes and cylinders (upright prisms) and for ellipsoids reaching their widest below it,
