@@ -594,20 +594,33 @@ TEST(LocalizationLog, EachFrameWithItsOutcomeErrorAndConsistency) {
       << csv;
 }
 
+// Exact to the millimetre against the footprints, not a map's cells: a box the base drives at and
+// a round bush beside it; a crown above the base's top is no obstacle.
 TEST(TrialEvaluator, MeasuresClearanceOfTheBaseOutline) {
-  garden::OccupancyMap world;
-  world.resolution = 0.05;
-  world.origin = {-1.0, -2.0};
-  world.occupied = cv::Mat::zeros(80, 100, CV_8U);  // 5 x 4 m
-  // An obstacle over x 2.0..2.5, y -0.5..0.5.
-  world.occupied(cv::Rect(world.Cell({2.0, 0.475}), world.Cell({2.475, -0.5})) + cv::Size(1, 1)).setTo(255);
-  const auto clearance_at = [&](double x) {
+  garden::Garden world;
+  garden::GardenObject box;  // x 2.0..2.5, y -0.5..0.5
+  box.id = 1;
+  box.position = {2.25, 0.0};
+  box.size = {0.5, 1.0, 1.0};
+  garden::GardenObject bush = box;  // a cylinder of radius 0.3 centred 1 m to the robot's left
+  bush.id = 2;
+  bush.shape = garden::Shape::kCylinder;
+  bush.position = {0.0, 1.0};
+  bush.size = {0.6, 0.6, 1.0};
+  garden::GardenObject crown = bush;  // a crown above the robot's top, right over it
+  crown.id = 3;
+  crown.shape = garden::Shape::kEllipsoid;
+  crown.position = {1.0, 0.0};
+  crown.base_height = 0.8;
+  world.objects = {box, bush, crown};
+  const auto clearance_at = [&](double x, double yaw) {
     TrialEvaluator evaluator({}, GoalCriteria{}, 1.0);
-    evaluator.MeasureClearance(world, {-0.12, -0.235}, {0.58, 0.235});
+    evaluator.MeasureClearance(world, 0.6, {-0.12, -0.235}, {0.58, 0.235});
     sim::SensorOutputs sensors;
     std::vector<messages::PoseFix> fixes;
     sim::GroundTruth truth;
     truth.T_map_base.translation() = Eigen::Vector3d(x, 0.0, 0.0);
+    truth.T_map_base.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     messages::RobotCommands commands;
     stack::Telemetry telemetry;
     evaluator.Observe({0.1, 0.1, sensors, fixes, truth, commands, &telemetry});
@@ -615,8 +628,11 @@ TEST(TrialEvaluator, MeasuresClearanceOfTheBaseOutline) {
     evaluator.Finish(true, 10.0, telemetry, &result);
     return result.min_clearance_m.value_or(std::numeric_limits<double>::quiet_NaN());
   };
-  EXPECT_NEAR(clearance_at(1.2), 2.0 - 1.78, 0.05) << "the outline's front at 1.78 m";
-  EXPECT_NEAR(clearance_at(1.6), 2.0 - 2.18, 0.05) << "0.18 m into the obstacle";
+  EXPECT_NEAR(clearance_at(1.2, 0.0), 2.0 - 1.78, 0.001) << "the outline's front at 1.78 m";
+  EXPECT_NEAR(clearance_at(1.6, 0.0), 2.0 - 2.18, 0.001) << "0.18 m into the box";
+  EXPECT_NEAR(clearance_at(0.0, 0.0), 1.0 - 0.3 - 0.235, 0.001) << "the bush beside the base";
+  // Turned a quarter to the left, the base's front (0.58 m) points at the bush.
+  EXPECT_NEAR(clearance_at(0.0, M_PI / 2), 1.0 - 0.3 - 0.58, 0.001) << "the bush ahead";
 }
 
 }  // namespace

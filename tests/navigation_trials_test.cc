@@ -158,6 +158,36 @@ TEST(PriorKnowledge, ASurveyCarriesTapeErrors) {
   EXPECT_NE(SurveyedGarden(built, survey, "test.yaml").objects[0].position, surveyed.objects[0].position);
 }
 
+// A survey drawn per trial (narrow_gap.yaml) is seeded by the trial's seed: the trial with the
+// batch's seed gets the batch's survey, another trial another survey, prior map and mission, and the
+// world and the truth stay the batch's. A `seed` beside `per_trial` contradicts it and is refused.
+TEST(PriorKnowledge, ASurveyDrawnPerTrialTakesTheTrialsSeed) {
+  const ProjectPaths paths{TRIMBOT_SOURCE_DIR};
+  const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/narrow_gap.yaml"));
+  ASSERT_TRUE(s.survey.per_trial);
+  const PreparedTrial batch = PrepareTrial(s, paths);
+  const PreparedTrial first = WithTrialSurvey(batch, s, s.setting.seed);
+  const PreparedTrial second = WithTrialSurvey(batch, s, s.setting.seed + 1);
+  ASSERT_EQ(first.surveyed.objects.size(), second.surveyed.objects.size());
+  EXPECT_EQ(first.surveyed.objects[0].position, batch.surveyed.objects[0].position);
+  EXPECT_EQ(cv::countNonZero(first.prior_map.occupied != batch.prior_map.occupied), 0);
+  EXPECT_NE(second.surveyed.objects[0].position, batch.surveyed.objects[0].position);
+  EXPECT_GT(cv::countNonZero(second.prior_map.occupied != batch.prior_map.occupied), 0);
+  EXPECT_EQ(second.garden.objects[0].position, batch.garden.objects[0].position);
+  EXPECT_EQ(second.goal_truths[0].position, batch.goal_truths[0].position);
+
+  const std::string text = testing::ReadText(testing::SourcePath("scenarios/navigation/narrow_gap.yaml"));
+  const std::string seeded = testing::WriteTempFile(
+      "per_trial_seed.yaml", std::regex_replace(text, std::regex("per_trial: true"), "per_trial: true, seed: 3"));
+  try {
+    Scenario::Load(seeded);
+    ADD_FAILURE() << "a per-trial survey with its own seed was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("per_trial_seed.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("seed"), std::string::npos) << e.what();
+  }
+}
+
 // The stack starts from the true start plus the seeded placement error, and reads a calibration
 // with the seeded calibration error; the simulator keeps the true one.
 TEST(PriorKnowledge, StartAndCalibrationCarryTheirSeededErrors) {

@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -333,6 +334,31 @@ bool InFootprint(const GardenObject& object, const Eigen::Vector2d& point, doubl
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector2d> FootprintBoundary(const GardenObject& object, double scale, double spacing) {
+  const Eigen::Vector2d half = scale * object.size.head<2>() / 2;
+  const Eigen::Rotation2Dd rotation(object.yaw);
+  std::vector<Eigen::Vector2d> points;
+  if (object.shape == Shape::kBox) {
+    const Eigen::Vector2d corners[4] = {{-half.x(), -half.y()}, {half.x(), -half.y()}, half, {-half.x(), half.y()}};
+    for (int side = 0; side < 4; ++side) {
+      const Eigen::Vector2d a = corners[side], b = corners[(side + 1) % 4];
+      const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+      for (int k = 0; k < steps; ++k) {
+        points.push_back(object.position + rotation * (a + (static_cast<double>(k) / steps) * (b - a)));
+      }
+    }
+    return points;
+  }
+  // An ellipse: a step in its angle moves a boundary point at most the longer semi-axis times it.
+  const int steps = std::max(8, static_cast<int>(std::ceil(2.0 * M_PI * half.maxCoeff() / spacing)));
+  for (int k = 0; k < steps; ++k) {
+    const double angle = 2.0 * M_PI * k / steps;
+    points.push_back(object.position +
+                     rotation * Eigen::Vector2d(half.x() * std::cos(angle), half.y() * std::sin(angle)));
+  }
+  return points;
+}
 
 const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance) {
   for (const auto& object : garden.objects) {

@@ -159,38 +159,46 @@ void TrialEvaluator::ObserveContacts(const StepView& step) {
   in_contact_ = contact;
 }
 
-void TrialEvaluator::MeasureClearance(const garden::OccupancyMap& true_map, const Eigen::Vector2d& outline_min,
-                                      const Eigen::Vector2d& outline_max) {
-  // Signed distance to the objects' surfaces: in free cells to the nearest occupied one, in occupied
-  // cells minus the distance to the nearest free one (cells outside the map: unknown); between
-  // cell centres, so half a cell less (more inside): a cell is occupied when its centre lies in a
-  // footprint, so the surface lies half a cell from the last occupied centre, on average.
-  cv::Mat free = true_map.occupied == 0, inside, side;
-  cv::distanceTransform(free, obstacle_distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  free.convertTo(side, CV_32F, 1.0 / 255.0, -0.5);  // +0.5 in free cells, -0.5 in occupied ones
-  obstacle_distance_ = (obstacle_distance_ - inside - side) * true_map.resolution;
-  true_map_ = true_map;
-  // The outline's perimeter every ~2 cm.
-  outline_.clear();
-  const Eigen::Vector2d corners[4] = {
-      outline_min, {outline_max.x(), outline_min.y()}, outline_max, {outline_min.x(), outline_max.y()}};
-  for (int side = 0; side < 4; ++side) {
-    const Eigen::Vector2d a = corners[side], b = corners[(side + 1) % 4];
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.02)));
-    for (int k = 0; k < steps; ++k) outline_.push_back(a + (static_cast<double>(k) / steps) * (b - a));
+void TrialEvaluator::MeasureClearance(const garden::Garden& world, double clearance_height,
+                                      const Eigen::Vector2d& outline_min, const Eigen::Vector2d& outline_max) {
+  // Boundary points 2 mm apart: a distance to them errs by at most 1 mm.
+  constexpr double kSpacing = 0.002;
+  footprints_.clear();
+  for (const garden::GardenObject& object : world.objects) {
+    const double scale = garden::FootprintScaleBelow(object, clearance_height);
+    if (scale <= 0.0) continue;
+    Footprint footprint;
+    footprint.centre = object.position;
+    footprint.boundary = garden::FootprintBoundary(object, scale, kSpacing);
+    for (const Eigen::Vector2d& p : footprint.boundary) {
+      footprint.reach = std::max(footprint.reach, (p - footprint.centre).norm());
+    }
+    footprints_.push_back(std::move(footprint));
+  }
+  outline_min_ = outline_min;
+  outline_max_ = outline_max;
+}
+
+void TrialEvaluator::MeasureClearanceAt(const PlanarPose& truth) {
+  // The signed distance of a footprint's boundary point to the outline (a rectangle in base_link):
+  // outside, to its nearest edge; inside, minus the way out. A footprint whose every point is
+  // farther than the clearance found so far is skipped.
+  const Eigen::Vector2d position(truth.x, truth.y);
+  const Eigen::Rotation2Dd to_base(-truth.yaw);
+  const double outline_reach = outline_min_.cwiseAbs().cwiseMax(outline_max_.cwiseAbs()).norm();
+  for (const Footprint& footprint : footprints_) {
+    if ((footprint.centre - position).norm() - footprint.reach - outline_reach >= min_clearance_) continue;
+    for (const Eigen::Vector2d& point : footprint.boundary) {
+      const Eigen::Vector2d q = to_base * (point - position);
+      const Eigen::Vector2d outside = (outline_min_ - q).cwiseMax(q - outline_max_);
+      const double distance = outside.maxCoeff() > 0.0 ? outside.cwiseMax(0.0).norm() : outside.maxCoeff();
+      min_clearance_ = std::min(min_clearance_, distance);
+    }
   }
 }
 
 void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
-  if (!obstacle_distance_.empty()) {
-    for (const Eigen::Vector2d& p : outline_) {
-      const cv::Point cell = true_map_.Cell(FromFrame({truth.x, truth.y, truth.yaw}, p));
-      if (!cv::Rect(0, 0, obstacle_distance_.cols, obstacle_distance_.rows).contains(cell)) continue;
-      // The point is within half a cell of its cell's centre: count that against the robot.
-      min_clearance_ = std::min(min_clearance_, obstacle_distance_.at<float>(cell) - 0.5 * true_map_.resolution);
-    }
-  }
+  if (!footprints_.empty()) MeasureClearanceAt(truth);
   const Pose2& estimate = step.telemetry->estimate.pose;
   const Pose2& odometry = step.telemetry->odometry;
   sample_times_.push_back(step.time);

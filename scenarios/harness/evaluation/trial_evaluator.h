@@ -42,9 +42,10 @@ class TrialEvaluator : public Observer {
 
   void Observe(const StepView& step) override;
   // Also measure the smallest clearance between the robot's base outline (a rectangle in
-  // base_link, RobotDescription::BaseOutline) at its true pose and the garden as it is (`world`);
-  // negative: how deep the outline reaches into an obstacle's cells.
-  void MeasureClearance(const garden::OccupancyMap& true_map, const Eigen::Vector2d& outline_min,
+  // base_link, RobotDescription::BaseOutline) at its true pose and the footprints of the garden as
+  // it is (`world`: its objects' parts below `clearance_height`), exact to 1 mm; negative: how deep
+  // a footprint reaches into the outline.
+  void MeasureClearance(const garden::Garden& world, double clearance_height, const Eigen::Vector2d& outline_min,
                         const Eigen::Vector2d& outline_max);
 
   // Completes `result` (status, goals, counts, errors) from what was observed; `finished`: the
@@ -58,6 +59,7 @@ class TrialEvaluator : public Observer {
     double t = 0.0, x = 0.0, y = 0.0, yaw = 0.0;
   };
   static PlanarPose Planar(double t, const Eigen::Isometry3d& pose);
+  void MeasureClearanceAt(const PlanarPose& truth);
   const PlanarPose* TruthAt(double stamp) const;
   void ObserveEvents(const StepView& step, const PlanarPose& truth);
   void ObserveContacts(const StepView& step);
@@ -91,11 +93,15 @@ class TrialEvaluator : public Observer {
   std::vector<double> sample_times_, fix_stamps_;  // for the localization rate
   long steps_ = 0;
   double timestep_ = 0.0;
-  // Clearance: signed metres from each world cell to the nearest obstacle boundary (positive in
-  // free space; empty: not measured), and points along the base's outline in base_link.
-  cv::Mat obstacle_distance_;
-  garden::OccupancyMap true_map_;  // its cells
-  std::vector<Eigen::Vector2d> outline_;
+  // Clearance: the world's footprints as points along their boundaries (empty: not measured), and
+  // the base's outline in base_link.
+  struct Footprint {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    double reach = 0.0;  // m from the centre to the farthest boundary point
+    std::vector<Eigen::Vector2d> boundary;
+  };
+  std::vector<Footprint> footprints_;
+  Eigen::Vector2d outline_min_ = Eigen::Vector2d::Zero(), outline_max_ = Eigen::Vector2d::Zero();
   double min_clearance_ = std::numeric_limits<double>::infinity();
 };
 

@@ -11,16 +11,15 @@
 namespace trimbot::scenarios {
 namespace {
 
-// The garden as it is in the trials - its objects, the scenario's unmapped objects, foliage at the
-// conditions' growth - on the prior map's cells (for plots and clearance: what the robot's map lacks).
-garden::OccupancyMap TrueMap(const Scenario& scenario, const garden::Garden& built, double clearance_height) {
+// The garden as it is in the trials: its objects, the scenario's unmapped objects, foliage at the
+// conditions' growth.
+garden::Garden TrueGarden(const Scenario& scenario, const garden::Garden& built) {
   garden::Garden in_trials = built;
   in_trials.AddObjects(scenario.survey.unmapped_objects);
   Survey as_grown;
   as_grown.point_sigma = 0.0;  // the truth, not a survey
   as_grown.growth = scenario.setting.conditions.growth;
-  return garden::MakeOccupancyMap(SurveyedGarden(in_trials, as_grown, scenario.source), scenario.map_resolution,
-                                  clearance_height);
+  return SurveyedGarden(in_trials, as_grown, scenario.source);
 }
 
 // Where each goal truly is: a point goal's position, a bush's true centre (the garden file's object).
@@ -107,8 +106,20 @@ PreparedTrial PrepareTrial(const Scenario& scenario, const ProjectPaths& paths) 
            "arm_reach: bush " + std::to_string(scenario.arm_reach->bush));
   }
   prepared.goal_truths = GoalTruths(scenario, prepared.garden);
-  prepared.true_map = TrueMap(scenario, prepared.garden, clearance_height);
+  prepared.true_garden = TrueGarden(scenario, prepared.garden);
+  prepared.clearance_height = clearance_height;
+  prepared.true_map = garden::MakeOccupancyMap(prepared.true_garden, scenario.map_resolution, clearance_height);
   return prepared;
+}
+
+PreparedTrial WithTrialSurvey(const PreparedTrial& batch, const Scenario& scenario, std::uint64_t trial_seed) {
+  Survey survey = scenario.survey;
+  survey.seed = trial_seed;
+  PreparedTrial trial = batch;
+  trial.surveyed = SurveyedGarden(trial.garden, survey, scenario.source);
+  trial.prior_map = PriorMap(scenario, trial.surveyed, trial.clearance_height);
+  trial.mission = MissionGoals(scenario, trial.surveyed);
+  return trial;
 }
 
 std::vector<Eigen::Vector2d> GoalPositions(const std::vector<stack::Goal>& goals) {

@@ -65,6 +65,10 @@ Survey ReadSurvey(const YamlMap& map, std::uint64_t scenario_seed) {
   Survey survey;
   survey.point_sigma = map.NumberOr("point_sigma", survey.point_sigma, 0.0, 1.0, "m");
   survey.seed = ReadSeed(map, scenario_seed);
+  survey.per_trial = map.Bool("per_trial", false);
+  if (survey.per_trial && map.Has("seed")) {
+    map.Fail("seed", "a survey drawn per trial takes each trial's seed; give the scenario's seed instead");
+  }
   survey.growth = map.NumberOr("growth", 0.0, 0.0, 1.0);
   if (map.Has("unmapped")) {
     survey.unmapped = map.Integers("unmapped", 1, garden::kMaxGardenObjectId);

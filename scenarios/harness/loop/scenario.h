@@ -48,6 +48,9 @@ struct Survey {
   // garden was surveyed once, so every trial of a batch shares the survey).
   double point_sigma = kTapeSurveyPointSigma;
   std::uint64_t seed = 0;
+  // A survey drawn afresh for each trial, seeded by the trial's seed, so that a batch measures a
+  // rate over surveys rather than one survey's luck (a gap the survey may narrow or widen).
+  bool per_trial = false;
   double growth = 0.0;        // foliage as it was when surveyed (0..1, as Conditions)
   std::vector<int> unmapped;  // object ids the survey missed
   // Objects in the world that are not in the garden file either (a wheelbarrow left on the lawn):

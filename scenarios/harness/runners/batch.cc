@@ -316,7 +316,14 @@ struct RunningTrial {
 [[noreturn]] void RunTrialProcess(const TrialSetup& setup) {
   int code = 0;
   try {
-    RunTrial(setup, [&](double t) { std::ofstream(setup.dir + "/progress") << t << "\n"; });
+    TrialSetup own = setup;
+    PreparedTrial surveyed_for_trial;
+    if (setup.scenario->survey.per_trial) {
+      surveyed_for_trial = WithTrialSurvey(*setup.prepared, *setup.scenario, setup.seed);
+      own.prepared = &surveyed_for_trial;
+      own.map_yaml = WritePriorMap(surveyed_for_trial.prior_map, setup.dir + "/map");
+    }
+    RunTrial(own, [&](double t) { std::ofstream(setup.dir + "/progress") << t << "\n"; });
   } catch (const std::exception& e) {
     TrialResult result = Unfinished(setup.index, setup.seed, "error", e.what());
     try {

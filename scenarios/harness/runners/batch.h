@@ -9,7 +9,9 @@
 //   batch.json                    scenario file, seed, trials, shard of this run
 //   scenario.yaml                 copy of the scenario file
 //   map/map.{png,yaml}            the robot's prior map (map_server)
-//   trials/NNN/                   per trial: result.json, *.tum, events.csv
+//   trials/NNN/                   per trial: result.json, *.tum, events.csv; map/ its own prior
+//                                 map when the survey is drawn per trial (then map/ above is the
+//                                 survey of the batch's seed, shown under the batch's plots)
 //   summary.json, junit.xml       batch metrics and pass criteria (expected / actual / pass);
 //                                 summary.json is the same, byte for byte, for the same scenario and seed
 //   timing.json                   wall-clock seconds per trial

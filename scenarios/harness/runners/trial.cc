@@ -162,7 +162,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   TrialEvaluator evaluator(setup.prepared->goal_truths, criteria,
                            std::max(scenario.simulated_pose_fixes.latency_max, parameters.visual.latency_max) + 1.0);
   const auto [outline_min, outline_max] = simulator.robot().BaseOutline();
-  evaluator.MeasureClearance(setup.prepared->true_map, outline_min, outline_max);
+  evaluator.MeasureClearance(setup.prepared->true_garden, setup.prepared->clearance_height, outline_min, outline_max);
   StackPilot pilot(robot);
   LoopOptions options;
   options.time_limit = scenario.time_limit;

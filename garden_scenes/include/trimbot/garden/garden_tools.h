@@ -50,6 +50,10 @@ struct OccupancyMap {
 // else the ellipsoid's cross-section at that height (a tree crown the robot passes under at its rim
 // but not near the trunk). 0 when nothing of it is below.
 double FootprintScaleBelow(const GardenObject& object, double clearance);
+// Points along the boundary of an object's footprint scaled by `scale` (FootprintScaleBelow), at
+// most `spacing` apart, corners of a box included: for exact distances to the footprint (a
+// polygon's distance to it errs by at most half the spacing).
+std::vector<Eigen::Vector2d> FootprintBoundary(const GardenObject& object, double scale, double spacing);
 // The first object whose part below `clearance` covers `point` (what the robot can run into there;
 // an ellipsoid crown by its cross-section at that height), or null.
 const GardenObject* ObjectAt(const Garden& garden, const Eigen::Vector2d& point, double clearance);
