@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
 
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
@@ -16,6 +17,7 @@
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "reports/batch_report.h"
+#include "runners/drive.h"
 #include "runners/localization_eval.h"
 #include "runners/map_cache.h"
 #include "runners/mapping.h"
@@ -191,6 +193,62 @@ TEST(MapBuild, ALogBuiltMapOfAShortDriveIsWithinItsStatedErrors) {
   EXPECT_LT(stats["evaluation"]["points_to_true_surfaces_m"]["median"].get<double>(), 0.05);
   for (const char* file : {"keyframes.tum", "keyframes_odometry.tum", "keyframes_truth.tum", "loops.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + file)) << file;
+  }
+}
+
+// From a folder `trimbot drive` recorded (every ring frame saved): the same map as from driving
+// the plan, within the same stated errors as the log-built map above; a saved frame that cannot be
+// read is a gap the build reports, not a failure; a malformed sensor log is refused naming the
+// file and the line.
+TEST(MapBuild, AMapFromARecordedDriveIsWithinItsStatedErrorsAndReportsItsGaps) {
+  const std::string recording = testing::TempDir("recorded_lawn_drive");
+  std::string plan = testing::ReadText(testing::SourcePath("scenarios/drive_plans/lawn_loop.yaml"));
+  plan = std::regex_replace(plan, std::regex("save_every_frames: 10"), "save_every_frames: 1");
+  scenarios::DriveOptions drive;
+  drive.plan_path = testing::WriteTempFile("lawn_loop_every_frame.yaml", plan);
+  drive.output_dir = recording;
+  drive.seconds = 10.0;
+  drive.quiet = true;
+  drive.paths = {TRIMBOT_SOURCE_DIR};
+  ASSERT_EQ(scenarios::RunDrive(drive), 0);
+  // A second without camera 3 (frames 15-19, 0.3-0.55 m into the drive): one of them is due for a
+  // keyframe at the 0.3 m spacing, and each one after it until a frame can be read.
+  for (int frame = 15; frame <= 19; ++frame) {
+    ASSERT_TRUE(std::filesystem::remove(recording + "/frames/0000" + std::to_string(frame) + "/cam3.png"));
+  }
+
+  scenarios::MapBuildOptions options;
+  options.recipe.plan_path = recording;
+  options.recipe.builder = KeyframePoses::kOdometry;
+  options.out_dir = testing::TempDir("map_from_recording");
+  options.paths = {TRIMBOT_SOURCE_DIR};
+  ASSERT_EQ(scenarios::RunMapBuild(options), 0);
+  std::ifstream in(options.out_dir + "/map_stats.json");
+  const nlohmann::json stats = nlohmann::json::parse(in);
+  EXPECT_GE(stats["keyframes"].get<int>(), 5);
+  const auto& built = stats["evaluation"]["keyframes"];
+  std::printf("log map of a 10 s recording: ATE aligned %.4f m (odometry %.4f m), unaligned %.4f m\n",
+              built["ate_se3_aligned_m"]["mean"].get<double>(),
+              stats["evaluation"]["odometry"]["ate_se3_aligned_m"]["mean"].get<double>(),
+              built["ate_unaligned_m"]["mean"].get<double>());
+  EXPECT_LT(built["ate_se3_aligned_m"]["mean"].get<double>(),
+            ScaleErrorBound(options.out_dir + "/keyframes_truth.tum"));
+  EXPECT_LT(built["ate_unaligned_m"]["mean"].get<double>(), 0.15);
+  EXPECT_LT(stats["evaluation"]["points_to_true_surfaces_m"]["median"].get<double>(), 0.05);
+  ASSERT_GE(stats["log"]["frames_unreadable"].size(), 1u);
+  for (const auto& gap : stats["log"]["frames_unreadable"]) {
+    EXPECT_TRUE(std::regex_search(gap.get<std::string>(), std::regex("00001[5-9]/cam3.png"))) << gap;
+  }
+
+  std::string imu = testing::ReadText(recording + "/sensors/imu.csv");
+  imu.insert(imu.find('\n', imu.find('\n') + 1) + 1, "0.01,1,2\n");  // line 3
+  WriteFileAtomically(recording + "/sensors/imu.csv", imu);
+  try {
+    scenarios::RunMapBuild(options);
+    ADD_FAILURE() << "a malformed IMU log was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), recording + "/sensors/imu.csv");
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
   }
 }
 

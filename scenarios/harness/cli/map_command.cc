@@ -72,7 +72,11 @@ void AddMapCommands(Commands& commands) {
   auto seconds = std::make_shared<double>(0.0);
   auto* build =
       map->add_subcommand("build", "render a mapping drive and build a map (Upright-SIFT, Ceres bundle adjustment)");
-  build->add_option("plan", options->recipe.plan_path, "drive plan (YAML) of the mapping drive")->required();
+  build
+      ->add_option("plan", options->recipe.plan_path,
+                   "the mapping drive: a drive plan or scenario (YAML) to drive, or a folder `trimbot drive` recorded "
+                   "(its IMU, wheel ticks and saved ring frames)")
+      ->required();
   build->add_option("--out", options->out_dir, "output folder (map.sqlite, map_stats.json, map_top_view.png)")
       ->required();
   auto* seed_option =

@@ -9,12 +9,9 @@
 
 #include <vector>
 
-namespace trimbot::scenarios {
+#include "evaluation/tum_trajectory.h"
 
-struct StampedPose {
-  double stamp = 0.0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-};
+namespace trimbot::scenarios {
 
 // Keyframe errors of `estimate` against `truth` (same order, same stamps): ATE unaligned and
 // SE(3)-aligned (position, m), RPE per step (m, deg). JSON with count, mean, median, rmse, max.

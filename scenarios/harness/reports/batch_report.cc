@@ -1,5 +1,7 @@
 #include "reports/batch_report.h"
 
+#include "evaluation/tum_trajectory.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -568,31 +570,8 @@ std::vector<LocalizationFrame> ReadLocalizationCsv(const std::string& path) {
 }
 
 std::vector<Eigen::Vector2d> ReadTumPositions(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw InputError(path, "cannot open the trajectory file");
   std::vector<Eigen::Vector2d> positions;
-  std::string line;
-  for (int line_number = 1; std::getline(file, line); ++line_number) {
-    const std::size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream words(line);
-    std::vector<double> values;
-    std::string word;
-    while (words >> word) {
-      char* end = nullptr;
-      const double value = std::strtod(word.c_str(), &end);
-      if (end == word.c_str() || *end != '\0' || !std::isfinite(value)) {
-        throw InputError(path, "line " + std::to_string(line_number) + ": '" + word + "' is not a finite number");
-      }
-      values.push_back(value);
-    }
-    if (values.size() != 8) {
-      throw InputError(path, "line " + std::to_string(line_number) +
-                                 ": expected 8 numbers \"t x y z qx qy qz qw\", got " + std::to_string(values.size()));
-    }
-    positions.emplace_back(values[1], values[2]);
-  }
-  if (file.bad()) throw InputError(path, "read error");
+  for (const StampedPose& pose : ReadTum(path)) positions.push_back(pose.T.translation().head<2>());
   return positions;
 }
 

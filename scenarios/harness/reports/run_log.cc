@@ -85,16 +85,20 @@ void RunLog::LogRing(const StepView& step) {
                   pose.translation().x(), pose.translation().y(), pose.translation().z(), q.x(), q.y(), q.z(), q.w());
     cameras_csv_ += line;
   }
-  if (frames_ % save_every_ == 0) {
+  const bool save = frames_ % save_every_ == 0;
+  if (save) {
     SaveRing(frame, truth, FrameDir(out_, frames_));
     ++saved_frames_;
   }
+  std::snprintf(line, sizeof(line), "%ld,%.6f,%d\n", frames_, frame.stamp, save ? 1 : 0);
+  ring_csv_ += line;
   ++frames_;
 }
 
 void RunLog::Write() const {
   WriteFileAtomically(out_ + "/sensors/imu.csv", imu_csv_);
   WriteFileAtomically(out_ + "/sensors/wheel_ticks.csv", ticks_csv_);
+  WriteFileAtomically(out_ + "/sensors/ring.csv", ring_csv_);
   WriteFileAtomically(out_ + "/ground_truth/base.tum", base_tum_);
   WriteFileAtomically(out_ + "/ground_truth/arm.csv", arm_csv_);
   WriteFileAtomically(out_ + "/ground_truth/cameras.csv", cameras_csv_);

@@ -30,6 +30,7 @@ class RunLog : public Observer {
   int save_every_;
   std::string imu_csv_ = "t,ax,ay,az,gx,gy,gz\n";
   std::string ticks_csv_ = "t,left,right\n";
+  std::string ring_csv_ = "frame,t,saved\n";  // every ring frame's stamp, and whether frames/ holds it
   std::string base_tum_, odometry_tum_;
   std::string arm_csv_ = "t,q1,q2,q3,q4,q5,q6\n";
   std::string cameras_csv_ = "t,camera,x,y,z,qx,qy,qz,qw\n";

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
@@ -93,6 +95,9 @@ int RunDrive(const DriveOptions& options) {
   const auto setup_start = Clock::now();
   sim::Simulator simulator(config);
   WriteFileAtomically(out + "/calibration/camchain.yaml", simulator.rig().ToKalibrYaml());
+  // The plan beside the log: `trimbot map build` takes the garden and the stated start from it.
+  std::ifstream plan_file(options.plan_path);
+  WriteFileAtomically(out + "/plan.yaml", std::string(std::istreambuf_iterator<char>(plan_file), {}));
 
   // The stack listens (wheel odometry, EKF) from the plan's start; the plan drives.
   stack::RobotStack listener(options.paths.robot_files(), parameters, config.seed);

@@ -2,9 +2,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,12 +18,14 @@
 #include "evaluation/tum_trajectory.h"
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
+#include "loop/drive_recording.h"
 #include "loop/pilots.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "loop/simulated_pose_fixes.h"
 #include "reports/map_plot.h"
 #include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
 #include "trimbot/common/rotation.h"
 #include "trimbot/common/yaml_reader.h"
@@ -305,7 +310,137 @@ sim::SimulatorConfig MappingSimulatorConfig(const MapBuildOptions& options, cons
   return config;
 }
 
+namespace {
+
+// The build's end, whatever the drive: bundle adjustment, map.sqlite, the top view and
+// map_stats.json, with what `evaluate` adds (timed as the evaluation).
+int FinishMapBuild(const MapBuildOptions& options, visual_localization::MapBuilder& builder,
+                   const garden::Garden& garden, std::uint64_t seed, double drive_seconds, Clock::time_point wall_start,
+                   const std::function<void(nlohmann::json&, const visual_localization::VisualMap&,
+                                            const visual_localization::MapBuildStats&)>& evaluate) {
+  std::cout << "[map] drive done, " << builder.keyframes() << " keyframes in " << static_cast<int>(drive_seconds)
+            << " s; features, matching, bundle adjustment..." << std::endl;
+  visual_localization::MapBuildStats stats;
+  visual_localization::VisualMap map = builder.Build(garden.name, &stats);
+  map.appearance_version = garden::kTextureGeneratorVersion;
+  if (map.points.empty()) {
+    throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" +
+                             std::to_string(stats.keyframes) + " keyframes; too short, or nothing textured in view)");
+  }
+  map.Save(options.out_dir + "/map.sqlite");
+  const garden::OccupancyMap objects = garden::MakeOccupancyMap(garden, 0.05, 1.0);
+  WriteMapTopView(options.out_dir + "/map_top_view.png", map, objects,
+                  "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
+                      std::to_string(stats.keyframes) + " keyframes");
+  const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  nlohmann::json report =
+      MapStats(options.recipe.plan_path, seed, visual_localization::ToString(options.recipe.builder), map, stats,
+               drive_seconds, total_seconds);
+  const auto evaluation_start = Clock::now();
+  evaluate(report, map, stats);
+  report["seconds"]["evaluation"] = std::chrono::duration<double>(Clock::now() - evaluation_start).count();
+  WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
+  std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "
+            << stats.mean_track_length << ", reprojection RMSE " << stats.reprojection_rmse_px << " px, "
+            << total_seconds << " s -> " << options.out_dir << "/map.sqlite" << std::endl;
+  return 0;
+}
+
+// The true base pose nearest to each stamp (the recording's base.tum has one per physics step).
+std::vector<StampedPose> TruthAt(const std::vector<StampedPose>& truth, const std::vector<double>& stamps) {
+  std::vector<StampedPose> nearest;
+  for (const double stamp : stamps) {
+    auto after = std::lower_bound(truth.begin(), truth.end(), stamp,
+                                  [](const StampedPose& pose, double t) { return pose.stamp < t; });
+    if (after == truth.end() || (after != truth.begin() && stamp - std::prev(after)->stamp < after->stamp - stamp)) {
+      --after;
+    }
+    nearest.push_back(*after);
+  }
+  return nearest;
+}
+
+// A map from a recorded drive (a `trimbot drive` folder): its IMU and wheel ticks replayed through
+// the wheel-inertial odometry, its saved ring frames offered to the builder at their stamps, the
+// garden as surveyed (seeded by the drive's seed) for the tie. Saved frames that cannot be read are
+// gaps, reported; the recording's ground truth (ground_truth/base.tum) goes to the evaluation only.
+int RunMapBuildFromRecording(const MapBuildOptions& options) {
+  const auto wall_start = Clock::now();
+  const std::string& dir = options.recipe.plan_path;
+  if (options.recipe.builder != visual_localization::KeyframePoses::kOdometry) {
+    throw InputError(dir, "a recorded drive is built from its log (--builder log): survey poses need the truth");
+  }
+  const DriveRecording recording = DriveRecording::Load(dir);
+  Setting setting = recording.plan().setting;
+  if (options.recipe.seed) setting.seed = *options.recipe.seed;
+  const double until = options.recipe.seconds.value_or(std::numeric_limits<double>::infinity());
+  std::filesystem::create_directories(options.out_dir);
+  const stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
+  const robot::CameraRig rig =
+      CalibratedRig(robot::LoadCameraRig(options.paths.robot_files()), options.recipe.calibration_error);
+  visual_localization::MapBuilder builder(
+      rig, MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(parameters.visual.descriptor)));
+  const garden::Garden garden = LoadGarden(setting, options.paths);
+  Survey survey;
+  survey.seed = setting.seed;
+  builder.SetSurveyedShapes(SurveyedShapes(SurveyedGarden(garden, survey, recording.plan().source)));
+  const robot::RobotDescription description = robot::RobotDescription::Load(options.paths.robot_files().urdf);
+  stack::InertialOdometry odometry(
+      parameters.ekf, description.drive(),
+      robot::RobotParameters::Load(options.paths.robot_files().robot_parameters).wheel_encoders.ticks_per_revolution,
+      0.0, BelievedPose(setting.start, kInitialPositionSigma, kInitialYawSigma, setting.seed));
+
+  std::cout << "[map] replaying " << dir << ": " << recording.frames().size() << " ring frames" << std::endl;
+  std::vector<double> keyframe_stamps;
+  std::vector<std::string> gaps;
+  std::size_t next_imu = 0, next_ticks = 0;
+  const auto& imu = recording.imu();
+  const auto& ticks = recording.wheel_ticks();
+  for (const RecordedRingFrame& frame : recording.frames()) {
+    if (frame.stamp > until) break;
+    // The sensors up to the frame, in the order they arrived.
+    while ((next_imu < imu.size() && imu[next_imu].stamp <= frame.stamp) ||
+           (next_ticks < ticks.size() && ticks[next_ticks].stamp <= frame.stamp)) {
+      const bool imu_first = next_ticks >= ticks.size() || ticks[next_ticks].stamp > frame.stamp ||
+                             (next_imu < imu.size() && imu[next_imu].stamp <= ticks[next_ticks].stamp);
+      if (imu_first) {
+        odometry.Add(imu[next_imu++]);
+      } else {
+        odometry.Add(ticks[next_ticks++]);
+      }
+    }
+    const Eigen::Isometry3d pose = ToIsometry(odometry.pose());
+    if (!frame.saved || !builder.WantsFrame(pose)) continue;
+    std::string gap;
+    const auto ring =
+        recording.LoadFrame(frame, rig.size(), rig.camera(0).intrinsics.width, rig.camera(0).intrinsics.height, &gap);
+    if (!ring) {
+      gaps.push_back(gap);
+      continue;
+    }
+    if (builder.AddFrame(*ring, pose)) keyframe_stamps.push_back(frame.stamp);
+  }
+  const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  const std::string truth_path = dir + "/ground_truth/base.tum";
+  return FinishMapBuild(options, builder, garden, setting.seed, drive_seconds, wall_start,
+                        [&](nlohmann::json& report, const visual_localization::VisualMap& map,
+                            const visual_localization::MapBuildStats& stats) {
+                          report["log"] = LogBuildStats(stats, builder.loops().size());
+                          report["log"]["frames_unreadable"] = gaps;
+                          if (!std::filesystem::exists(truth_path)) {
+                            report["evaluation"] = "none: the recording has no ground_truth/base.tum";
+                            return;
+                          }
+                          report["evaluation"] =
+                              EvaluateLogMap(builder, map, TruthAt(ReadTum(truth_path), keyframe_stamps), garden,
+                                             setting.conditions.growth, options.out_dir);
+                        });
+}
+
+}  // namespace
+
 int RunMapBuild(const MapBuildOptions& options) {
+  if (std::filesystem::is_directory(options.recipe.plan_path)) return RunMapBuildFromRecording(options);
   const auto wall_start = Clock::now();
   std::filesystem::create_directories(options.out_dir);
   const std::unique_ptr<MappingDrive> drive = LoadMappingDrive(options);
@@ -349,40 +484,19 @@ int RunMapBuild(const MapBuildOptions& options) {
             << " s), rendering keyframes" << std::endl;
   RunClosedLoop(simulator, *drive->pilot, {&recorder}, loop);
   const double drive_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
-
-  std::cout << "[map] drive done, " << builder.keyframes() << " keyframes in " << static_cast<int>(drive_seconds)
-            << " s; features, matching, bundle adjustment..." << std::endl;
-  visual_localization::MapBuildStats stats;
-  visual_localization::VisualMap map = builder.Build(simulator.garden().name, &stats);
-  map.appearance_version = garden::kTextureGeneratorVersion;
-  if (map.points.empty()) {
-    throw std::runtime_error(options.recipe.plan_path + ": the mapping drive gave no map points (" +
-                             std::to_string(stats.keyframes) + " keyframes; too short, or nothing textured in view)");
-  }
-  map.Save(options.out_dir + "/map.sqlite");
-  const garden::OccupancyMap objects = garden::MakeOccupancyMap(simulator.garden(), 0.05, 1.0);
-  WriteMapTopView(options.out_dir + "/map_top_view.png", map, objects,
-                  "map of " + map.garden + ": " + std::to_string(stats.points) + " points, " +
-                      std::to_string(stats.keyframes) + " keyframes");
-  const double total_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  nlohmann::json report =
-      MapStats(options.recipe.plan_path, setting.seed, visual_localization::ToString(builder_options.poses), map, stats,
-               drive_seconds, total_seconds);
-  if (from_log) {
-    report["log"] = LogBuildStats(stats, builder.loops().size());
-    const auto evaluation_start = Clock::now();
-    report["evaluation"] = EvaluateLogMap(builder, map, log_recorder.truth(), simulator.garden(),
-                                          setting.conditions.growth, options.out_dir);
-    report["seconds"]["evaluation"] = std::chrono::duration<double>(Clock::now() - evaluation_start).count();
-  } else {
-    report["keyframes_against_ground_truth"] =
-        KeyframeErrors(map, survey, CameraImuTimeOffset(options.recipe.calibration_error));
-  }
-  WriteFileAtomically(options.out_dir + "/map_stats.json", report.dump(2));
-  std::cout << "[map] " << stats.keyframes << " keyframes, " << stats.points << " points, mean track "
-            << stats.mean_track_length << ", reprojection RMSE " << stats.reprojection_rmse_px << " px, "
-            << total_seconds << " s -> " << options.out_dir << "/map.sqlite" << std::endl;
-  return 0;
+  const double growth = setting.conditions.growth;
+  return FinishMapBuild(options, builder, simulator.garden(), setting.seed, drive_seconds, wall_start,
+                        [&](nlohmann::json& report, const visual_localization::VisualMap& map,
+                            const visual_localization::MapBuildStats& stats) {
+                          if (from_log) {
+                            report["log"] = LogBuildStats(stats, builder.loops().size());
+                            report["evaluation"] = EvaluateLogMap(builder, map, log_recorder.truth(),
+                                                                  simulator.garden(), growth, options.out_dir);
+                          } else {
+                            report["keyframes_against_ground_truth"] =
+                                KeyframeErrors(map, survey, CameraImuTimeOffset(options.recipe.calibration_error));
+                          }
+                        });
 }
 
 }  // namespace trimbot::scenarios
