@@ -182,11 +182,47 @@ TEST(PathFollower, DrivesTightSegmentsAsPlanned) {
   EXPECT_THROW(follower.SetPath(path, {0.05}), std::invalid_argument);
 }
 
+// Goals with a heading are arrived at facing it (a turn on the spot where the path ends, lined up
+// within exact_align_tolerance); a goal whose heading puts the outline into the wall moves to the
+// nearest position where the outline fits at that heading (reported), not to another heading.
+TEST(Navigator, ArrivesAtAGoalsHeading) {
+  SeedPlanner(5);
+  const OccupancyGrid map = WallMap();
+  Navigator navigator(map, kOutline, NavigatorParameters{});
+  const std::vector<NavigationGoal> goals{{Eigen::Vector2d(8.0, 2.0), M_PI / 2},
+                                          {Eigen::Vector2d(2.0, 1.5), M_PI},
+                                          {Eigen::Vector2d(4.3, 3.0), 0.0}};  // the base's front 0.08 m into the wall
+  navigator.SetGoals(goals);
+  Pose2 pose{2.0, 2.0, 0.0};
+  std::vector<Pose2> arrivals;
+  double adjusted = 0.0;
+  for (double t = 0.0; t < 600.0 && navigator.mode() != Navigator::Mode::kDone; t += 0.05) {
+    pose = Integrate(pose, navigator.Update(t, pose), 0.05);
+    for (const auto& e : navigator.TakeEvents()) {
+      if (e.type == NavigationEvent::Type::kGoalReached) arrivals.push_back(pose);
+      if (e.type == NavigationEvent::Type::kGoalAdjusted) adjusted = (e.position - goals[2].position).norm();
+    }
+  }
+  ASSERT_EQ(navigator.mode(), Navigator::Mode::kDone);
+  ASSERT_EQ(arrivals.size(), 3u);
+  const double tolerance = FollowerParameters{}.exact_align_tolerance;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(std::remainder(arrivals[i].yaw - *goals[i].yaw, 2.0 * M_PI)), tolerance) << "goal " << i;
+  }
+  EXPECT_LT((Eigen::Vector2d(arrivals[0].x, arrivals[0].y) - goals[0].position).norm(), 0.1);
+  // At heading 0 the outline's front (0.58 m ahead) keeps min_clearance from the wall at x 4.8
+  // only from 4.8 - 0.58 - min_clearance back: the goal moves at least that far (and by less than
+  // the search radius), not to another heading.
+  EXPECT_GE(adjusted, 4.3 - (4.8 - kOutline.max().x() - NavigatorParameters{}.planner.min_clearance) - 1e-9);
+  EXPECT_LT(adjusted, NavigatorParameters{}.goal_search_radius);
+  EXPECT_LT(arrivals[2].x + kOutline.max().x(), 4.8 - 0.05);
+}
+
 TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   SeedPlanner(11);
   const OccupancyGrid map = WallMap();
   Navigator navigator(map, kOutline, NavigatorParameters{});
-  navigator.SetGoals({{8.0, 2.0}, {2.0, 1.5}});
+  navigator.SetGoals({Eigen::Vector2d(8.0, 2.0), Eigen::Vector2d(2.0, 1.5)});
   Pose2 pose{2.0, 2.0, M_PI / 2};
   std::vector<NavigationEvent> events;
   double t = 0.0;
@@ -206,7 +242,7 @@ TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   // Driving north along the wall, 0.5 m from it, the estimate jumps 0.45 m towards the wall (a
   // re-localization): the outline now overlaps it while moving - stop, back off.
   Navigator stopper(map, kOutline, NavigatorParameters{});
-  stopper.SetGoals({{4.3, 5.5}});
+  stopper.SetGoals({Eigen::Vector2d(4.3, 5.5)});
   Pose2 truth{4.3, 1.0, M_PI / 2};
   bool stopped = false, backed = false;
   for (int k = 0; k < 400 && !backed; ++k) {
@@ -248,7 +284,7 @@ TEST(Navigator, PlansAgainWhenASeenObstacleBlocksThePath) {
   SeedPlanner(12);
   const OccupancyGrid map = WallMap();
   Navigator navigator(map, kOutline, NavigatorParameters{});
-  navigator.SetGoals({{3.8, 7.0}});
+  navigator.SetGoals({Eigen::Vector2d(3.8, 7.0)});
   Pose2 pose{3.8, 0.8, M_PI / 2};
   const Eigen::Vector2d box(3.8, 4.0);  // 0.4 m square, on the straight line to the goal
   cv::Mat occupied = map.occupied().clone();

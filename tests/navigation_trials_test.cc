@@ -293,7 +293,7 @@ TEST(Scenario, FixtureSettingsWithoutTheFixtureAreAnInputError) {
 TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
   for (const auto& [goal, problem] : std::vector<std::pair<std::string, std::string>>{
            {"{approach_bush: 999}", "has no object 999"}, {"{approach_bush: 5}", "is a hedge, not a bush"}}) {
-    const Scenario s = Scenario::Load(SmokeVariant("bad_bush.yaml", "\\{x: 4.0, y: 0.0\\}", goal));
+    const Scenario s = Scenario::Load(SmokeVariant("bad_bush.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", goal));
     try {
       PrepareTrial(s, ProjectPaths{TRIMBOT_SOURCE_DIR});
       ADD_FAILURE() << goal << " accepted";
@@ -304,7 +304,8 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
   }
   // A real bush gives the stack its surveyed centre and shape: the survey's, off the true centre
   // (1.5, -2.2) by the survey's error, and the truth stays with the evaluation.
-  const Scenario ok = Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0\\}", "{approach_bush: 3}"));
+  const Scenario ok =
+      Scenario::Load(SmokeVariant("good_bush.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{approach_bush: 3}"));
   const PreparedTrial prepared = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
   const std::vector<stack::Goal>& goals = prepared.mission;
   ASSERT_EQ(goals.size(), 1u);
@@ -489,10 +490,15 @@ TEST(Scenario, StartsAndGoalsThatCannotBeAreRefusedNamingTheObject) {
   const struct {
     std::string replace, with, expected;
   } cases[] = {
-      {"- \\{x: 4.0, y: 0.0\\}", "- {x: 20.0, y: 0.0}", "goals[0] at (20, 0) is outside the garden 'test_lawn'"},
-      {"- \\{x: 4.0, y: 0.0\\}", "- {x: 8.5, y: 0.0}", "goals[0] at (8.5, 0) lies inside object 5 (hedge)"},
+      {"- \\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "- {x: 20.0, y: 0.0}",
+       "goals[0] at (20, 0) is outside the garden 'test_lawn'"},
+      {"- \\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "- {x: 8.5, y: 0.0}",
+       "goals[0] at (8.5, 0) lies inside object 5 (hedge)"},
       {"start: \\{x: 0.0, y: 0.0, yaw_deg: 0.0\\}", "start: {x: 3.0, y: 1.2, yaw_deg: 0.0}",
        "start: the base's outline at (3, 1.2) overlaps object 1 (topiary)"},
+      // Outside the topiary (radius 0.4 m), but facing it the base's front reaches 0.58 m ahead.
+      {"- \\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "- {x: 2.3, y: 1.2, yaw_deg: 0.0}",
+       "goals[0] with its heading: the base's outline at (2.3, 1.2) overlaps object 1 (topiary)"},
   };
   for (const auto& c : cases) {
     const std::string path = SmokeVariant("places.yaml", c.replace, c.with);
@@ -504,6 +510,19 @@ TEST(Scenario, StartsAndGoalsThatCannotBeAreRefusedNamingTheObject) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
     }
+  }
+}
+
+// A bush goal's heading is the servo's bearing to the bush: a heading given for one is refused.
+TEST(Scenario, ABushGoalTakesNoHeading) {
+  const std::string path =
+      SmokeVariant("bush_heading.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{approach_bush: 3, yaw_deg: 90}");
+  try {
+    Scenario::Load(path);
+    ADD_FAILURE() << "a bush goal with a heading was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bush_heading.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("yaw_deg"), std::string::npos) << e.what();
   }
 }
 

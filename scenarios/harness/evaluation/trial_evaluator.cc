@@ -32,6 +32,7 @@ std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals) {
     result.x = result.used_x = goal.position.x();
     result.y = result.used_y = goal.position.y();
     result.bush = goal.bush;
+    if (goal.yaw) result.yaw_deg = *goal.yaw * 180.0 / M_PI;
     results.push_back(result);
   }
   return results;
@@ -239,6 +240,11 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
       goal.adjusted_by_m = std::hypot(goal.used_x - goal.x, goal.used_y - goal.y);
       goal.final_error_m = std::hypot(truth.x - goal.used_x, truth.y - goal.used_y);
       goal.reached = goal.final_error_m <= criteria_.tolerance;
+      if (goal.yaw_deg) {
+        const double error = AngleDifference(truth.yaw, *goal.yaw_deg * M_PI / 180.0);
+        goal.final_heading_error_deg = error * 180.0 / M_PI;
+        goal.reached = goal.reached && std::abs(error) <= criteria_.yaw_tolerance;
+      }
     }
   }
 }

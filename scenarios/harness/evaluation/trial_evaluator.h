@@ -30,6 +30,7 @@ std::vector<GoalResult> UnreachedGoals(const std::vector<GoalTruth>& goals);
 // When a goal counts as reached (ground truth at the robot's declared arrival).
 struct GoalCriteria {
   double tolerance = 0.3;                    // m from a point goal
+  double yaw_tolerance = 0.25;               // rad from a point goal's heading, if it has one
   double bush_distance = 0.03;               // m from the standoff the stack aimed at (arm's axis to the centre)
   double bush_bearing = 3.0 * M_PI / 180.0;  // rad from the bearing it aimed at
   Eigen::Vector2d arm_axis = Eigen::Vector2d::Zero();  // base_link: where bush distances are measured from

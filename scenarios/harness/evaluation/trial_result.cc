@@ -54,6 +54,8 @@ void to_json(nlohmann::json& j, const GoalResult& g) {
        {"adjusted_by_m", g.adjusted_by_m},
        {"used_x", g.used_x},
        {"used_y", g.used_y}};
+  if (g.yaw_deg) j["yaw_deg"] = *g.yaw_deg;
+  if (g.final_heading_error_deg) j["final_heading_error_deg"] = *g.final_heading_error_deg;
   if (g.bush != 0) {
     j["bush"] = g.bush;
     j["bush_distance_error_m"] = g.bush_distance_error_m;
@@ -72,6 +74,8 @@ void from_json(const nlohmann::json& j, GoalResult& g) {
   g.adjusted_by_m = j.value("adjusted_by_m", 0.0);  // results written before goals could move
   g.used_x = j.value("used_x", g.x);
   g.used_y = j.value("used_y", g.y);
+  if (j.contains("yaw_deg")) g.yaw_deg = j.at("yaw_deg").get<double>();
+  if (j.contains("final_heading_error_deg")) g.final_heading_error_deg = j.at("final_heading_error_deg").get<double>();
   g.bush = j.value("bush", 0);
   g.bush_distance_error_m = j.value("bush_distance_error_m", 0.0);
   g.bush_bearing_error_deg = j.value("bush_bearing_error_deg", 0.0);

@@ -46,6 +46,10 @@ struct GoalResult {
   // at (within its goal_search_radius): arrival is judged there, and the move is reported.
   double adjusted_by_m = 0.0;         // 0: the goal as asked
   double used_x = 0.0, used_y = 0.0;  // the goal navigated to (as asked, or adjusted)
+  // A goal with a heading: the true heading's difference to it at the declared arrival (reached:
+  // also within the scenario's goal_yaw_tolerance).
+  std::optional<double> yaw_deg;                  // the goal's heading
+  std::optional<double> final_heading_error_deg;  // true heading - the goal's, at arrival
   // A bush goal (approach_bush): the arm's axis at the robot's true pose against the bush's true
   // centre when the robot declared arrival (reached: both errors within the bush tolerance).
   int bush = 0;                                  // garden object id; 0: a point goal

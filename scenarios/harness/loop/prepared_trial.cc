@@ -30,7 +30,7 @@ std::vector<GoalTruth> GoalTruths(const Scenario& scenario, const garden::Garden
         goal.bush == 0
             ? goal.position
             : BushOf(built, goal.bush, scenario, "goals: approach_bush " + std::to_string(goal.bush)).position;
-    truths.push_back({position, goal.bush});
+    truths.push_back({position, goal.yaw, goal.bush});
   }
   return truths;
 }
@@ -46,30 +46,34 @@ std::string Named(const garden::GardenObject& object) {
   return "object " + std::to_string(object.id) + " (" + garden::ToString(object.object_class) + ")";
 }
 
-// Places the scenario names that cannot be: a start where the base's outline (the URDF's) overlaps
-// an object of the garden as it stands, a point goal outside the garden or inside an object.
-// InputError naming the scenario file, the start or goal, and the object.
+// Places the scenario names that cannot be: a start (or a goal with a heading) where the base's
+// outline (the URDF's) reaches outside the garden or overlaps an object of the garden as it stands,
+// a point goal outside the garden or inside an object. InputError naming the scenario file, the
+// start or goal, and the object.
 void CheckPlaces(const Scenario& scenario, const garden::Garden& garden, const ProjectPaths& paths, double clearance) {
   const Eigen::Vector2d low = garden.centre - garden.size / 2, high = garden.centre + garden.size / 2;
   const auto outside = [&](const Eigen::Vector2d& p) {
     return (p.array() < low.array()).any() || (p.array() > high.array()).any();
   };
-  const Pose2& start = scenario.setting.start;
   const auto [min, max] = robot::RobotDescription::Load(paths.robot_files().urdf).BaseOutline();
-  constexpr double kStep = 0.02;  // m between the outline's probed points
-  for (double x = min.x(); x <= max.x() + 1e-9; x += kStep) {
-    for (double y = min.y(); y <= max.y() + 1e-9; y += kStep) {
-      const Eigen::Vector2d p =
-          Eigen::Vector2d(start.x, start.y) + Eigen::Rotation2Dd(start.yaw) * Eigen::Vector2d(x, y);
-      if (outside(p))
-        throw InputError(scenario.source, "start: the base at " + At({start.x, start.y}) +
-                                              " reaches outside the garden '" + garden.name + "'");
-      if (const garden::GardenObject* object = garden::ObjectAt(garden, p, clearance)) {
-        throw InputError(scenario.source,
-                         "start: the base's outline at " + At({start.x, start.y}) + " overlaps " + Named(*object));
+  const auto check_outline = [&](const std::string& what, const Pose2& pose) {
+    constexpr double kStep = 0.02;  // m between the outline's probed points
+    for (double x = min.x(); x <= max.x() + 1e-9; x += kStep) {
+      for (double y = min.y(); y <= max.y() + 1e-9; y += kStep) {
+        const Eigen::Vector2d p =
+            Eigen::Vector2d(pose.x, pose.y) + Eigen::Rotation2Dd(pose.yaw) * Eigen::Vector2d(x, y);
+        if (outside(p)) {
+          throw InputError(scenario.source, what + ": the base at " + At({pose.x, pose.y}) +
+                                                " reaches outside the garden '" + garden.name + "'");
+        }
+        if (const garden::GardenObject* object = garden::ObjectAt(garden, p, clearance)) {
+          throw InputError(scenario.source,
+                           what + ": the base's outline at " + At({pose.x, pose.y}) + " overlaps " + Named(*object));
+        }
       }
     }
-  }
+  };
+  check_outline("start", scenario.setting.start);
   for (std::size_t i = 0; i < scenario.goals.size(); ++i) {
     const ScenarioGoal& goal = scenario.goals[i];
     if (goal.bush != 0) continue;  // a bush goal is checked against the garden's bushes
@@ -82,6 +86,9 @@ void CheckPlaces(const Scenario& scenario, const garden::Garden& garden, const P
     if (const garden::GardenObject* object = garden::ObjectAt(garden, goal.position, clearance)) {
       throw InputError(scenario.source, what + " lies inside " + Named(*object));
     }
+    if (goal.yaw)
+      check_outline("goals[" + std::to_string(i) + "] with its heading",
+                    {goal.position.x(), goal.position.y(), *goal.yaw});
   }
 }
 

@@ -7,6 +7,7 @@
 //   the ground truth        - where the goals truly are, the garden on the map's cells -> evaluation
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "loop/scenario.h"
@@ -20,6 +21,7 @@ namespace trimbot::scenarios {
 // A goal as the evaluation judges it.
 struct GoalTruth {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's, or the bush's true centre
+  std::optional<double> yaw;                           // a point goal's heading (rad), if it has one
   int bush = 0;                                        // garden object id; 0: a point goal
 };
 

@@ -127,6 +127,7 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
   for (const ScenarioGoal& goal : scenario.goals) {
     if (goal.bush == 0) {
       goals.emplace_back(goal.position);
+      goals.back().yaw = goal.yaw;
       continue;
     }
     const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario, ApproachBush(goal.bush));

@@ -141,8 +141,10 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     ScenarioGoal g;
     if (goal.Has("approach_bush")) {
       g.bush = goal.Integer("approach_bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
+      if (goal.Has("yaw_deg")) goal.Fail("yaw_deg", "a bush goal's heading is the bush's bearing (give none)");
     } else {
       g.position = {goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m")};
+      if (goal.Has("yaw_deg")) g.yaw = goal.Number("yaw_deg", -360.0, 360.0, "deg") * M_PI / 180.0;
     }
     goal.RejectUnknownKeys();
     s.goals.push_back(g);
@@ -169,6 +171,8 @@ void ReadMission(const YamlMap& root, Scenario& s) {
     root.Fail("goals", "needs at least one goal");
   }
   s.goal_tolerance = root.NumberOr("goal_tolerance", s.goal_tolerance, 1e-3, 10.0, "m");
+  s.goal_yaw_tolerance =
+      root.NumberOr("goal_yaw_tolerance_deg", s.goal_yaw_tolerance * 180.0 / M_PI, 0.1, 180.0, "deg") * M_PI / 180.0;
   if (root.Has("bush_tolerance")) {
     const YamlMap tolerance = root.Map("bush_tolerance");
     s.bush_distance_tolerance = tolerance.NumberOr("distance", s.bush_distance_tolerance, 1e-4, 10.0, "m");

@@ -65,8 +65,13 @@ struct Survey {
 // trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff).
 struct ScenarioGoal {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's (a bush's: see MissionGoals)
+  std::optional<double> yaw;                           // rad, map frame (`yaw_deg`): a point goal's heading; unset: any
   int bush = 0;                                        // the garden object's id; 0: a point goal
 };
+
+// How far a goal's heading may be off when the scenario gives one: Nav2's default
+// (SimpleGoalChecker yaw_goal_tolerance, 0.25 rad), what users of a ROS navigation stack expect.
+constexpr double kGoalYawTolerance = 0.25;  // rad
 
 // An arm_reach scenario (`arm_reach:`): the base stands at the start; the arm reaches `poses`
 // random cutter poses around a bush, each reachable without collision (a witness configuration of
@@ -108,7 +113,8 @@ struct Scenario {
   Survey survey;
   std::vector<ScenarioGoal> goals;  // in order (none in an arm_reach scenario)
   std::optional<ArmReach> arm_reach;
-  double goal_tolerance = 0.3;  // m: a goal counts as reached within this (ground truth)
+  double goal_tolerance = 0.3;                    // m: a goal counts as reached within this (ground truth)
+  double goal_yaw_tolerance = kGoalYawTolerance;  // rad: and within this of its heading, if it has one
   // A bush goal counts as reached when the arm's axis stands within these of the standoff
   // distance and bearing the stack aimed at (ground truth).
   double bush_distance_tolerance = 0.03;                  // m

@@ -156,6 +156,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   }
   GoalCriteria criteria;
   criteria.tolerance = scenario.goal_tolerance;
+  criteria.yaw_tolerance = scenario.goal_yaw_tolerance;
   criteria.bush_distance = scenario.bush_distance_tolerance;
   criteria.bush_bearing = scenario.bush_bearing_tolerance;
   criteria.arm_axis = simulator.robot().FramePose(robot::RobotFrames::kCameraRing).translation().head<2>();

@@ -179,13 +179,21 @@ bool GlobalPlanner::Valid(const Pose2& pose) const {
 
 namespace {
 
-// Of kHeadings headings at `position`, the one with the most clearance and that clearance.
-std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
+// The headings a goal may be arrived at: `yaw` if given, else kHeadings round.
+std::vector<double> GoalHeadings(std::optional<double> yaw) {
+  if (yaw) return {WrapAngle(*yaw)};
+  std::vector<double> headings;
+  for (int k = 0; k < kHeadings; ++k) headings.push_back(WrapAngle(2.0 * M_PI * k / kHeadings));
+  return headings;
+}
+
+// Of the goal headings at `position`, the one with the most clearance and that clearance.
+std::pair<double, double> BestHeading(const GlobalPlanner& planner, const Eigen::Vector2d& position,
+                                      std::optional<double> yaw = std::nullopt) {
   std::pair<double, double> best{0.0, -std::numeric_limits<double>::infinity()};
-  for (int k = 0; k < kHeadings; ++k) {
-    const double yaw = WrapAngle(2.0 * M_PI * k / kHeadings);
-    const double clearance = planner.Clearance({position.x(), position.y(), yaw});
-    if (clearance > best.second) best = {yaw, clearance};
+  for (const double heading : GoalHeadings(yaw)) {
+    const double clearance = planner.Clearance({position.x(), position.y(), heading});
+    if (clearance > best.second) best = {heading, clearance};
   }
   return best;
 }
@@ -223,10 +231,10 @@ constexpr double kMaxApproachRun = 4.0;  // m: the longest straight run into a g
 // and the base either turns round there or has a straight run into it from where it can
 // (TurnableApproach). A pose that fits only backing in, or only with a turn that the obstacles
 // around it forbid, is not a goal the drive can reach.
-bool Enterable(const GlobalPlanner& planner, const Eigen::Vector2d& position) {
+bool Enterable(const GlobalPlanner& planner, const Eigen::Vector2d& position, std::optional<double> yaw) {
   const ClearanceRule rule(planner);
-  for (int k = 0; k < kHeadings; ++k) {
-    const Pose2 at{position.x(), position.y(), WrapAngle(2.0 * M_PI * k / kHeadings)};
+  for (const double heading : GoalHeadings(yaw)) {
+    const Pose2 at{position.x(), position.y(), heading};
     if (!planner.Valid(at)) continue;
     if (CanTurnRound(planner, at) || TurnableApproach(planner, rule, at, kMaxApproachRun)) return true;
   }
@@ -447,11 +455,13 @@ std::optional<double> GlobalPlanner::FreeHeading(const Eigen::Vector2d& position
   return yaw;
 }
 
-std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vector2d& point, double radius,
-                                                               int count) const {
+std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vector2d& point, double radius, int count,
+                                                               std::optional<double> yaw) const {
   std::vector<Eigen::Vector2d> positions;
   if (count <= 0) return positions;
-  if (FreeHeading(point) && Enterable(*this, point)) positions.push_back(point);
+  if (BestHeading(*this, point, yaw).second >= parameters_.min_clearance && Enterable(*this, point, yaw)) {
+    positions.push_back(point);
+  }
   const double step = map_.resolution();
   for (double r = step; r <= radius + 1e-9 && static_cast<int>(positions.size()) < count; r += step) {
     // Within a ring, the roomiest first: where the outline has more clearance it can also turn.
@@ -460,12 +470,14 @@ std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vect
     for (int k = 0; k < around; ++k) {
       const double a = 2.0 * M_PI * k / around;
       const Eigen::Vector2d candidate = point + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-      const double clearance = BestHeading(*this, candidate).second;
+      const double clearance = BestHeading(*this, candidate, yaw).second;
       if (clearance >= parameters_.min_clearance) ring.emplace_back(clearance, candidate);
     }
     std::stable_sort(ring.begin(), ring.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
     for (const auto& [clearance, candidate] : ring) {
-      if (static_cast<int>(positions.size()) < count && Enterable(*this, candidate)) positions.push_back(candidate);
+      if (static_cast<int>(positions.size()) < count && Enterable(*this, candidate, yaw)) {
+        positions.push_back(candidate);
+      }
     }
   }
   return positions;
@@ -650,16 +662,16 @@ std::vector<Pose2> WithArrivalHeadings(const GlobalPlanner& planner, const Clear
 
 }  // namespace
 
-PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt) const {
+PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt,
+                               std::optional<double> yaw) const {
   PlanResult result;
   std::vector<double> goal_headings;
-  for (int k = 0; k < kHeadings; ++k) {
-    const double yaw = WrapAngle(2.0 * M_PI * k / kHeadings);
-    if (Valid({goal.x(), goal.y(), yaw})) goal_headings.push_back(yaw);
+  for (const double heading : GoalHeadings(yaw)) {
+    if (Valid({goal.x(), goal.y(), heading})) goal_headings.push_back(heading);
   }
   if (goal_headings.empty()) {
-    result.message = "the outline keeps " + std::to_string(parameters_.min_clearance) +
-                     " m from the obstacles at no heading at the goal";
+    result.message = "the outline keeps " + std::to_string(parameters_.min_clearance) + " m from the obstacles at " +
+                     (yaw ? "the goal's heading" : "no heading") + " at the goal";
     return result;
   }
   // After a drift or a recovery the robot may believe its outline overlaps an obstacle: plan from
@@ -693,6 +705,15 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   if (poses.empty()) return result;
   result.message.clear();
   poses = WithArrivalHeadings(*this, rule, poses);
+  if (yaw) {
+    // The turn on the spot to the goal's heading where the path ends (the follower makes it).
+    const Pose2 facing{poses.back().x, poses.back().y, WrapAngle(*yaw)};
+    if (!MotionClear(*this, rule, poses.back(), facing)) {
+      result.message = "no room to turn to the goal's heading where the path ends";
+      return result;
+    }
+    poses.push_back(facing);
+  }
 
   if (planning_start.x != start.x || planning_start.y != start.y) result.path.push_back({start.x, start.y});
   for (const Pose2& p : poses) {

@@ -97,7 +97,7 @@ std::optional<Eigen::Vector2d> Navigator::PathAheadBlocked(const Pose2& estimate
   return std::nullopt;
 }
 
-void Navigator::SetGoals(const std::vector<Eigen::Vector2d>& goals, int first_index) {
+void Navigator::SetGoals(const std::vector<NavigationGoal>& goals, int first_index) {
   goals_ = goals;
   goal_ = 0;
   first_index_ = first_index;
@@ -133,12 +133,13 @@ void Navigator::GiveUpGoal(double stamp, const std::string& why) {
 
 void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   const auto start = std::chrono::steady_clock::now();
-  const Eigen::Vector2d asked = goals_[goal_];
+  const Eigen::Vector2d asked = goals_[goal_].position;
+  const std::optional<double> yaw = goals_[goal_].yaw;
   if (plan_failures_ == 0) {
     // Where the outline fits, nearest first (the goal itself if it fits there): each failed plan
     // tries the next, since a pose that fits may not be reachable (no room to turn into it).
     goal_candidates_ =
-        planner_.StandablePositions(asked, parameters_.goal_search_radius, parameters_.max_plan_failures);
+        planner_.StandablePositions(asked, parameters_.goal_search_radius, parameters_.max_plan_failures, yaw);
     if (goal_candidates_.empty()) {
       GiveUpGoal(stamp, "the base's outline fits nowhere within " + std::to_string(parameters_.goal_search_radius) +
                             " m of the goal (keeping " + std::to_string(parameters_.planner.min_clearance) +
@@ -151,8 +152,8 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
   if (goal != asked) {
     Emit(stamp, NavigationEvent::Type::kGoalAdjusted, std::to_string((goal - asked).norm()) + " m", goal);
   }
-  // To the goal's position within half a cell, any heading.
-  const PlanResult plan = planner_.Plan(estimate, goal, 0.5 * costmap_.resolution(), plan_failures_);
+  // To the goal's position within half a cell, at its heading if it has one.
+  const PlanResult plan = planner_.Plan(estimate, goal, 0.5 * costmap_.resolution(), plan_failures_, yaw);
   active_goal_ = goal;
   planning_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!plan.found) {
@@ -167,7 +168,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
     }
     return;
   }
-  follower_.SetPath(plan.path, plan.clearance);
+  follower_.SetPath(plan.path, plan.clearance, yaw);
   mode_ = Mode::kFollowing;
   Emit(stamp, NavigationEvent::Type::kPlanned, std::to_string(plan.length) + " m", active_goal_);
 }

@@ -39,7 +39,8 @@ bool PathFollower::Reached(std::size_t v, const Eigen::Vector2d& position) const
   return distance < parameters_.vertex_tolerance && to_go < parameters_.exact_vertex_tolerance;
 }
 
-void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& clearance) {
+void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& clearance,
+                           std::optional<double> final_yaw) {
   if (!clearance.empty() && clearance.size() + 1 != path.size()) {
     throw std::invalid_argument("PathFollower::SetPath: one clearance per segment of the path");
   }
@@ -47,6 +48,8 @@ void PathFollower::SetPath(const std::vector<Eigen::Vector2d>& path, const std::
   clearance_ = clearance;
   segment_ = 0;
   aligned_ = false;
+  final_yaw_ = final_yaw;
+  at_end_ = false;
 }
 
 Eigen::Vector2d PathFollower::LookaheadPoint(double fraction, std::size_t stretch_end) const {
@@ -72,8 +75,16 @@ FollowerOutput PathFollower::Update(const Pose2& pose) {
   const Eigen::Vector2d position(pose.x, pose.y);
   const Eigen::Vector2d& goal = path_.back();
   out.distance_to_goal = (goal - position).norm();
-  if (out.distance_to_goal < parameters_.goal_tolerance) {
-    out.arrived = true;
+  if (at_end_ || out.distance_to_goal < parameters_.goal_tolerance) {
+    at_end_ = true;  // a turn on the spot does not leave the end
+    const double turn = final_yaw_ ? std::remainder(*final_yaw_ - pose.yaw, 2.0 * M_PI) : 0.0;
+    if (std::abs(turn) <= parameters_.exact_align_tolerance) {
+      out.arrived = true;
+      return out;
+    }
+    out.command.angular =
+        std::clamp(parameters_.heading_gain * turn, -parameters_.max_angular_speed, parameters_.max_angular_speed);
+    out.turn_left = turn;
     return out;
   }
 

@@ -121,7 +121,7 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
 void Mission::StartSegment(Navigator* navigator) {
   const Pose2 estimate = ekf_.Estimate().pose;
   Eigen::Vector2d from(estimate.x, estimate.y);
-  std::vector<Eigen::Vector2d> points;
+  std::vector<NavigationGoal> points;
   bush_goal_ = -1;
   servoing_ = false;
   for (int i = next_goal_; i < static_cast<int>(goals_.size()); ++i) {
@@ -131,7 +131,7 @@ void Mission::StartSegment(Navigator* navigator) {
       bush_goal_ = i;
       break;
     }
-    points.push_back(goal.position);
+    points.push_back({goal.position, goal.yaw});
     from = goal.position;
   }
   navigator->SetGoals(points, next_goal_);

@@ -58,9 +58,11 @@ class GlobalPlanner {
  public:
   GlobalPlanner(const OccupancyGrid& map, const BaseOutline& outline, const PlannerParameters& parameters);
 
-  // A path from `start` to a pose whose position is within `tolerance` of `goal` (any heading).
+  // A path from `start` to a pose whose position is within `tolerance` of `goal`, at heading `yaw`
+  // if given (the path ends with the turn on the spot to it, checked like every turn), else any.
   // `attempt` k > 0 (a retry after a failed plan) runs 2^k times the iterations.
-  PlanResult Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt = 0) const;
+  PlanResult Plan(const Pose2& start, const Eigen::Vector2d& goal, double tolerance, int attempt = 0,
+                  std::optional<double> yaw = std::nullopt) const;
 
   // The outline's clearance at `pose` (BaseOutline::Clearance on the map).
   double Clearance(const Pose2& pose, double enough = std::numeric_limits<double>::infinity()) const;
@@ -72,8 +74,10 @@ class GlobalPlanner {
   // (some heading keeps min_clearance there and either turns round there or has a straight run of
   // a base length behind it), nearest first (rings a cell apart, points about a cell apart on each;
   // `point` itself first if it qualifies). Such a position may still be unreachable from the start
-  // (the run behind it may lead nowhere): the navigator tries them in turn.
-  std::vector<Eigen::Vector2d> StandablePositions(const Eigen::Vector2d& point, double radius, int count) const;
+  // (the run behind it may lead nowhere): the navigator tries them in turn. With `yaw`, only that
+  // heading counts.
+  std::vector<Eigen::Vector2d> StandablePositions(const Eigen::Vector2d& point, double radius, int count,
+                                                  std::optional<double> yaw = std::nullopt) const;
   // The cost of the motion a -> b (turn, straight, turn), in metres.
   double MotionCost(const Pose2& a, const Pose2& b) const;
 

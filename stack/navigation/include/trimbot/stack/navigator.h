@@ -62,6 +62,16 @@ struct NavigationEvent {
 };
 const char* ToString(NavigationEvent::Type type);
 
+// A goal of the navigator: a position, and the heading to arrive with when it matters (map frame,
+// rad), else any.
+struct NavigationGoal {
+  NavigationGoal(const Eigen::Vector2d& point,
+                 std::optional<double> heading = std::nullopt)  // NOLINT: a point is a goal
+      : position(point), yaw(heading) {}
+  Eigen::Vector2d position;
+  std::optional<double> yaw;
+};
+
 class Navigator {
  public:
   enum class Mode { kIdle, kFollowing, kBackingOff, kDone, kFailed };
@@ -74,7 +84,7 @@ class Navigator {
 
   // Goals visited in order; events and current_goal() count them from `first_index` (the goals
   // may be a part of a longer mission).
-  void SetGoals(const std::vector<Eigen::Vector2d>& goals, int first_index = 0);
+  void SetGoals(const std::vector<NavigationGoal>& goals, int first_index = 0);
   // The prior map with what perception has seen added (same size, resolution and origin as the
   // prior map; std::invalid_argument otherwise). The path ahead is checked against it.
   void SetCostmap(OccupancyGrid costmap);
@@ -113,7 +123,7 @@ class Navigator {
   NavigatorParameters parameters_;
   GlobalPlanner planner_;
   PathFollower follower_;
-  std::vector<Eigen::Vector2d> goals_;
+  std::vector<NavigationGoal> goals_;
   int goal_ = 0;
   int first_index_ = 0;
   Mode mode_ = Mode::kIdle;

@@ -7,6 +7,7 @@
 // Where the plan passes close to obstacles (its clearance per segment below `exact_below`) it drives
 // the plan's own motions - to each vertex, turn on the spot, straight on - lined up tightly.
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "trimbot/common/pose2.h"
@@ -49,8 +50,10 @@ class PathFollower {
   explicit PathFollower(const FollowerParameters& parameters) : parameters_(parameters) {}
 
   // `clearance`: per segment (path[i] to path[i + 1]) the outline's clearance the plan keeps along
-  // it (PlanResult::clearance); empty: room everywhere.
-  void SetPath(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& clearance = {});
+  // it (PlanResult::clearance); empty: room everywhere. `final_yaw`: the heading to arrive with
+  // (a turn on the spot at the end, to within exact_align_tolerance), else any.
+  void SetPath(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& clearance = {},
+               std::optional<double> final_yaw = std::nullopt);
   FollowerOutput Update(const Pose2& pose);
   const std::vector<Eigen::Vector2d>& path() const { return path_; }
   std::size_t segment() const { return segment_; }  // being driven: path()[segment] to path()[segment + 1]
@@ -62,6 +65,8 @@ class PathFollower {
   std::vector<double> clearance_;  // per segment, or empty
   std::size_t segment_ = 0;        // progress along the path: never goes back, so loops are not cut
   bool aligned_ = false;           // has faced along the path since it was set (or since a sharp vertex)
+  std::optional<double> final_yaw_;
+  bool at_end_ = false;  // within goal_tolerance of the end: only the turn to final_yaw is left
 
   // Whether segment `s` is driven exactly (its clearance below exact_below).
   bool Exact(std::size_t s) const;

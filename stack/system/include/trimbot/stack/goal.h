@@ -15,6 +15,7 @@ struct Goal {
   // The bush as the survey knows it: its centre in the map and its shape (yaw in the map frame).
   static Goal ApproachBush(const Eigen::Vector2d& centre, const perception::BushShape& shape);
   Eigen::Vector2d position;                   // the point, or the bush's surveyed centre
+  std::optional<double> yaw;                  // a point goal's heading to arrive with (map frame, rad); unset: any
   std::optional<perception::BushShape> bush;  // set for a bush approach
 };
 
