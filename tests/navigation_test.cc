@@ -218,6 +218,57 @@ TEST(Navigator, ArrivesAtAGoalsHeading) {
   EXPECT_LT(arrivals[2].x + kOutline.max().x(), 4.8 - 0.05);
 }
 
+// Backing off after an obstacle stop undoes the way the robot came: it drove east, turned on the
+// spot to face north and drove on; stopped by a wall seen just ahead, it backs down to where it
+// turned, turns back and reverses west, where straight back would leave the way it came (and
+// sweep what it never swept) going south.
+TEST(Navigator, BacksOffTheWayItCame) {
+  SeedPlanner(3);
+  const OccupancyGrid map = WallMap();
+  Navigator navigator(map, kOutline, NavigatorParameters{});
+  navigator.SetGoals({Eigen::Vector2d(3.5, 1.0)});
+  // The way it came (the estimate, whatever the commands): 0.5 m east, a quarter turn, 0.1 m north.
+  std::vector<Pose2> way;
+  for (double x = 1.0; x <= 1.5 + 1e-9; x += 0.01) way.push_back({x, 1.0, 0.0});
+  for (double yaw = 0.0; yaw <= M_PI / 2 + 1e-9; yaw += 0.02) way.push_back({1.5, 1.0, yaw});
+  for (double y = 1.0; y <= 1.1 + 1e-9; y += 0.01) way.push_back({1.5, y, M_PI / 2});
+  double t = 0.0;
+  for (const Pose2& p : way) {
+    navigator.Update(t, p);
+    t += 0.05;
+  }
+  ASSERT_EQ(navigator.mode(), Navigator::Mode::kFollowing);
+  // A wall seen 2 cm ahead of the outline's front, across the way.
+  cv::Mat occupied = map.occupied().clone();
+  const Pose2 end = way.back();
+  const double wall_y = end.y + kOutline.max().x() + 0.02;
+  for (int r = 0; r < occupied.rows; ++r) {
+    for (int c = 0; c < occupied.cols; ++c) {
+      const Eigen::Vector2d p = map.CellCentre({c, r});
+      if (p.y() >= wall_y + 0.5 * map.resolution() && p.y() < wall_y + 0.3 && std::abs(p.x() - 1.5) < 1.0) {
+        occupied.at<uchar>(r, c) = 255;
+      }
+    }
+  }
+  navigator.SetCostmap(OccupancyGrid(occupied, map.resolution(), map.origin()));
+  Pose2 pose = end;
+  double lowest = pose.y;
+  bool stopped = false;
+  for (int k = 0; k < 400 && (!stopped || navigator.mode() == Navigator::Mode::kBackingOff); ++k, t += 0.05) {
+    pose = Integrate(pose, navigator.Update(t, pose), 0.05);
+    stopped = stopped || navigator.mode() == Navigator::Mode::kBackingOff;
+    if (stopped) lowest = std::min(lowest, pose.y);
+  }
+  ASSERT_TRUE(stopped) << "no obstacle stop";
+  EXPECT_NE(navigator.mode(), Navigator::Mode::kBackingOff);
+  EXPECT_GT(lowest, 1.0 - 0.02) << "backed off south of the way it came";
+  EXPECT_LT(pose.yaw, M_PI / 2 - 0.2) << "did not turn back where it had turned";
+  // Facing north (as it stopped) the wall stays as near on the way back west: it ends after
+  // max_backoff, on the way it came.
+  EXPECT_NEAR(pose.y, 1.0, 0.03);
+  EXPECT_LT(pose.x, 1.5 + 0.03);
+}
+
 TEST(Navigator, VisitsGoalsInOrderAndStopsAndBacksOffNearAnObstacle) {
   SeedPlanner(11);
   const OccupancyGrid map = WallMap();

@@ -163,7 +163,7 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
     } else {
       // Boxed in (no room to turn, and the drive plans forward motions only): back out the way it
       // came before the next try, as after an obstacle stop.
-      backoff_start_ = {estimate.x, estimate.y};
+      backoff_start_ = {estimate.x, estimate.y, estimate.yaw};
       mode_ = Mode::kBackingOff;
     }
     return;
@@ -198,6 +198,87 @@ std::string Navigator::DescribeBlock(const Eigen::Vector2d& blocked) const {
   return where.str();
 }
 
+namespace {
+
+// The trail: a pose each kTrailStep driven or kTrailTurn turned, the last kTrailPoses of them.
+constexpr double kTrailStep = 0.05;       // m
+constexpr double kTrailTurn = 0.1;        // rad
+constexpr std::size_t kTrailPoses = 200;  // >= 10 m of driving
+// A trail position counts as undone within half a step.
+constexpr double kTrailReached = 0.5 * kTrailStep;
+// The estimate this far from the trail's newest pose has jumped (a fix corrected it): the trail,
+// in the old estimate's frame, no longer says where the robot came from.
+constexpr double kTrailJump = 3.0 * kTrailStep;
+
+double AngleBetween(double to, double from) { return std::remainder(to - from, 2.0 * M_PI); }
+
+}  // namespace
+
+void Navigator::RecordTrail(const Pose2& estimate) {
+  if (!trail_.empty() && std::hypot(estimate.x - trail_.back().x, estimate.y - trail_.back().y) > kTrailJump) {
+    trail_.clear();
+  }
+  if (!trail_.empty()) {
+    const Pose2& last = trail_.back();
+    if (std::hypot(estimate.x - last.x, estimate.y - last.y) < kTrailStep &&
+        std::abs(AngleBetween(estimate.yaw, last.yaw)) < kTrailTurn) {
+      return;
+    }
+  }
+  trail_.push_back(estimate);
+  if (trail_.size() > kTrailPoses) trail_.pop_front();
+}
+
+messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& estimate) {
+  // Back until the outline, at the heading it stopped with, is clear again (or the back-off
+  // distance is used up, or the outline a few centimetres further back would come within
+  // stop_clearance of what is behind: reversing is checked like driving forward).
+  messages::BaseVelocityCommand command;
+  const double moved = std::hypot(estimate.x - backoff_start_.x, estimate.y - backoff_start_.y);
+  constexpr double kLookBehind = 0.05;  // m: a little more than one update's travel backwards
+  const Pose2 behind{estimate.x - kLookBehind * std::cos(estimate.yaw),
+                     estimate.y - kLookBehind * std::sin(estimate.yaw), estimate.yaw};
+  const double here = OutlineClearance({estimate.x, estimate.y, backoff_start_.yaw}, parameters_.resume_clearance);
+  const double there = OutlineClearance(behind, parameters_.resume_clearance);
+  if (here >= parameters_.resume_clearance || moved >= parameters_.max_backoff ||
+      (there < parameters_.stop_clearance && there < OutlineClearance(estimate) - 1e-3)) {
+    Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
+    mode_ = Mode::kIdle;
+    return command;  // plan on the next update, from where the robot stopped
+  }
+  // The way it came, undone newest first: reversing to each trail position in turn, turning back
+  // (on the spot) where the way turned, so the outline sweeps only what it swept coming in. A
+  // position reached or passed (ahead of the robot reversing) is done. With no trail left, or a
+  // turn back that would come within stop_clearance (the trail no longer fits the estimate):
+  // straight back.
+  const Eigen::Vector2d heading(std::cos(estimate.yaw), std::sin(estimate.yaw));
+  if (!trail_.empty() && std::hypot(estimate.x - trail_.back().x, estimate.y - trail_.back().y) > kTrailJump) {
+    trail_.clear();
+  }
+  while (!trail_.empty()) {
+    const Eigen::Vector2d to(trail_.back().x - estimate.x, trail_.back().y - estimate.y);
+    if (to.norm() >= kTrailReached && to.dot(heading) <= 0.0) break;
+    trail_.pop_back();
+  }
+  if (!trail_.empty()) {
+    const Eigen::Vector2d away(estimate.x - trail_.back().x, estimate.y - trail_.back().y);
+    const double error = AngleBetween(std::atan2(away.y(), away.x()), estimate.yaw);
+    const FollowerParameters& follower = parameters_.follower;
+    const bool aligned = std::abs(error) < follower.align_tolerance;
+    const Pose2 turned{estimate.x, estimate.y,
+                       estimate.yaw + std::copysign(std::min(parameters_.turn_check_angle, std::abs(error)), error)};
+    if (aligned || OutlineClearance(turned, parameters_.stop_clearance) >= parameters_.stop_clearance) {
+      command.angular =
+          std::clamp(follower.heading_gain * error, -follower.max_angular_speed, follower.max_angular_speed);
+      if (aligned) command.linear = -parameters_.backoff_speed;
+      return command;
+    }
+    trail_.clear();
+  }
+  command.linear = -parameters_.backoff_speed;
+  return command;
+}
+
 messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estimate) {
   messages::BaseVelocityCommand stop;
   if (mode_ == Mode::kDone || mode_ == Mode::kFailed) return stop;
@@ -207,26 +288,8 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
     if (mode_ != Mode::kFollowing) return stop;
   }
 
-  if (mode_ == Mode::kBackingOff) {
-    // Straight back until the outline is clear again (or the back-off distance is used up, or
-    // the outline a few centimetres further back would come within stop_clearance of what is
-    // behind: reversing is checked like driving forward).
-    const double moved = (Eigen::Vector2d(estimate.x, estimate.y) - backoff_start_).norm();
-    constexpr double kLookBehind = 0.05;  // m: a little more than one update's travel backwards
-    const Pose2 behind{estimate.x - kLookBehind * std::cos(estimate.yaw),
-                       estimate.y - kLookBehind * std::sin(estimate.yaw), estimate.yaw};
-    const double here = OutlineClearance(estimate, parameters_.resume_clearance);
-    const double there = OutlineClearance(behind, parameters_.resume_clearance);
-    if (here >= parameters_.resume_clearance || moved >= parameters_.max_backoff ||
-        (there < parameters_.stop_clearance && there < here - 1e-3)) {
-      Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
-      mode_ = Mode::kIdle;
-      return stop;  // plan on the next update, from where the robot stopped
-    }
-    messages::BaseVelocityCommand back;
-    back.linear = -parameters_.backoff_speed;
-    return back;
-  }
+  if (mode_ == Mode::kBackingOff) return BackOff(stamp, estimate);
+  RecordTrail(estimate);
 
   // Following.
   const FollowerOutput follow = follower_.Update(estimate);
@@ -257,7 +320,7 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
       GiveUpGoal(stamp, "too many recoveries");
       return stop;
     }
-    backoff_start_ = {estimate.x, estimate.y};
+    backoff_start_ = {estimate.x, estimate.y, estimate.yaw};
     mode_ = Mode::kBackingOff;
     return stop;
   }

@@ -2,13 +2,14 @@
 // Goal-to-goal navigation on the pose estimate: plan over the costmap (the prior map plus the
 // obstacles perception has seen, SetCostmap), follow the path, plan again when what is seen
 // blocks it, and when the robot (by its estimate) gets too close to an obstacle, stop, back off
-// and plan again - the recovery behaviour of the real robot's navigation. Every check is of the
+// the way it came and plan again - the recovery behaviour of the real robot's navigation. Every check is of the
 // base's real outline (BaseOutline). A goal where the outline fits at no heading is moved to the
 // nearest position where it fits, within goal_search_radius (reported), and given up with the
 // reason when there is none. A system with explicit input
 // (time, pose estimate), output (base velocity command) and state (goal, path, mode); the events it
 // reports (goal reached, replans, recoveries, failures) go to the evaluation.
 #include <Eigen/Core>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -109,6 +110,10 @@ class Navigator {
 
  private:
   void PlanToCurrentGoal(double stamp, const Pose2& estimate);
+  // Where the robot drives (by its estimate): appended to the trail it backs out along.
+  void RecordTrail(const Pose2& estimate);
+  // The back-off after an obstacle stop or a failed plan: the way it came, in reverse.
+  messages::BaseVelocityCommand BackOff(double stamp, const Pose2& estimate);
   void GiveUpGoal(double stamp, const std::string& why);
   void Emit(double stamp, NavigationEvent::Type type, const std::string& detail = {},
             const Eigen::Vector2d& position = Eigen::Vector2d::Zero());
@@ -129,7 +134,8 @@ class Navigator {
   Mode mode_ = Mode::kIdle;
   int recoveries_ = 0;
   int plan_failures_ = 0;
-  Eigen::Vector2d backoff_start_ = Eigen::Vector2d::Zero();
+  Pose2 backoff_start_;      // where the back-off started, and the heading it stopped with
+  std::deque<Pose2> trail_;  // the way the robot came, newest last (RecordTrail)
   std::vector<NavigationEvent> events_;
   double planning_seconds_ = 0.0;
   bool costmap_changed_ = false;
