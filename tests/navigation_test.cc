@@ -455,11 +455,11 @@ TEST(GlobalPlanner, PassesAGapWiderThanTheBaseAndRefusesANarrowerOne) {
   }
 }
 
-// A gap 0.2 m wider than the base (issue 30's narrow passage: 5 cm to spare a side beyond the 5 cm
-// walls) in a wall at 30 degrees to the map's axes: the 0.7 m long base fits through it only lined
-// up within 4 degrees, which a sampling planner rarely hits; the grid route, pulled taut where its
-// motions cut in at an angle, passes it whatever the seed. The plan reports its clearance per segment, the gap's below
-// the follower's exact_below.
+// A gap 0.15 m wider than the base (2.5 cm to spare a side beyond the 5 cm walls) in a wall at 30
+// degrees to the map's axes: the 0.7 m long base fits through it only lined up within 2 degrees,
+// which a sampling planner rarely hits; the grid route, pulled taut where its motions cut in at an
+// angle and backing up where a vertex leaves no room to turn into the gap, passes it whatever the
+// seed. The plan reports its clearance per segment, the gap's below the follower's exact_below.
 TEST(GlobalPlanner, PassesATightGapAtAnAngleWhateverTheSeed) {
   const double gap = kOutline.width() + 0.2;
   const Eigen::Vector2d centre(3.0, 3.0), along(std::cos(M_PI / 6), std::sin(M_PI / 6)), across(-along.y(), along.x());

@@ -14,6 +14,7 @@
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -409,6 +410,7 @@ std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& 
   if ((points.back() - goal).norm() > 1e-9) points.push_back(goal);
   constexpr double kSpacing = 0.4;           // m between vertices where the motions are clear
   constexpr double kPullReach = 4.0;         // m along the route: bounds the motions tried from a vertex
+  constexpr int kMotionBudget = 3000;        // motions checked in all before the route is given up
   std::vector<double> along(points.size());  // m along the route from the start
   for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector2d previous = k == 0 ? Eigen::Vector2d(start.x, start.y) : points[k - 1];
@@ -422,28 +424,43 @@ std::vector<Pose2> GridRoute(const GlobalPlanner& planner, const ClearanceRule& 
     return Pose2{to.x(), to.y(), std::atan2(to.y() - from.y, to.x() - from.x)};
   };
   const double quarter = 0.25 * planner.map().resolution();
-  std::vector<Pose2> poses{start};
-  double at = 0.0;       // m along the route of the last vertex
-  std::size_t next = 0;  // first point beyond it
-  while (next < points.size()) {
-    const Pose2 last = poses.back();
-    std::size_t spaced = next, farthest = next;
-    while (spaced + 1 < points.size() && along[spaced] - at < kSpacing) ++spaced;
-    while (farthest + 1 < points.size() && along[farthest + 1] - at <= kPullReach) ++farthest;
-    std::optional<std::pair<std::size_t, Pose2>> reached;
-    if (const Pose2 to = motion_to(last, spaced, 0.0); MotionClear(planner, rule, last, to)) reached = {spaced, to};
-    for (const double side : {0.0, quarter, -quarter, 2.0 * quarter, -2.0 * quarter}) {
-      for (std::size_t k = farthest + 1; !reached && k-- > next;) {
-        const bool is_goal = k + 1 == points.size();
-        if (is_goal && side != 0.0) continue;  // the goal stays where it is
-        if (const Pose2 to = motion_to(last, k, side); MotionClear(planner, rule, last, to)) reached = {k, to};
-      }
+  const std::array<double, 5> sides{0.0, quarter, -quarter, 2.0 * quarter, -2.0 * quarter};
+  // A depth-first search over the vertices: each tries its candidates in turn - the point 0.4 m
+  // on, then the farthest points first at each sideways offset - and when none leads on, the
+  // vertex before it tries its next (a vertex 0.4 m on can leave no room to turn into a passage).
+  struct Vertex {
+    Pose2 pose;
+    double at = 0.0;        // m along the route
+    std::size_t next = 0;   // first route point beyond it
+    std::size_t tried = 0;  // candidates tried
+  };
+  std::vector<Vertex> path{{start, 0.0, 0, 0}};
+  int budget = kMotionBudget;
+  while (!path.empty() && path.back().next < points.size()) {
+    Vertex& v = path.back();
+    std::size_t spaced = v.next, farthest = v.next;
+    while (spaced + 1 < points.size() && along[spaced] - v.at < kSpacing) ++spaced;
+    while (farthest + 1 < points.size() && along[farthest + 1] - v.at <= kPullReach) ++farthest;
+    const std::size_t per_side = farthest + 1 - v.next;
+    std::optional<Vertex> found;
+    for (; !found && v.tried < 1 + sides.size() * per_side && budget > 0; ++v.tried) {
+      const std::size_t c = v.tried == 0 ? 0 : v.tried - 1;
+      const std::size_t k = v.tried == 0 ? spaced : farthest - c % per_side;
+      const double side = v.tried == 0 ? 0.0 : sides[c / per_side];
+      if (k + 1 == points.size() && side != 0.0) continue;  // the goal stays where it is
+      const Pose2 to = motion_to(v.pose, k, side);
+      --budget;
+      if (MotionClear(planner, rule, v.pose, to)) found = Vertex{to, along[k], k + 1, 0};
     }
-    if (!reached) return {};
-    poses.push_back(reached->second);
-    at = along[reached->first];
-    next = reached->first + 1;
+    if (budget <= 0) return {};
+    if (found) {
+      path.push_back(*found);
+    } else {
+      path.pop_back();
+    }
   }
+  std::vector<Pose2> poses;
+  for (const Vertex& v : path) poses.push_back(v.pose);
   return poses;
 }
 
