@@ -461,7 +461,7 @@ TEST(GlobalPlanner, PassesAGapWiderThanTheBaseAndRefusesANarrowerOne) {
 // angle and backing up where a vertex leaves no room to turn into the gap, passes it whatever the
 // seed. The plan reports its clearance per segment, the gap's below the follower's exact_below.
 TEST(GlobalPlanner, PassesATightGapAtAnAngleWhateverTheSeed) {
-  const double gap = kOutline.width() + 0.2;
+  const double gap = kOutline.width() + 0.15;
   const Eigen::Vector2d centre(3.0, 3.0), along(std::cos(M_PI / 6), std::sin(M_PI / 6)), across(-along.y(), along.x());
   cv::Mat occupied(120, 120, CV_8U, cv::Scalar(0));
   const OccupancyGrid empty(occupied, 0.05, {0.0, 0.0});

@@ -162,8 +162,9 @@ void Navigator::PlanToCurrentGoal(double stamp, const Pose2& estimate) {
       GiveUpGoal(stamp, "no path: " + plan.message);
     } else {
       // Boxed in (no room to turn, and the drive plans forward motions only): back out the way it
-      // came before the next try, as after an obstacle stop.
+      // came before the next try, the whole max_backoff (the outline is clear: room is missing).
       backoff_start_ = {estimate.x, estimate.y, estimate.yaw};
+      backoff_until_clear_ = false;
       mode_ = Mode::kBackingOff;
     }
     return;
@@ -230,9 +231,10 @@ void Navigator::RecordTrail(const Pose2& estimate) {
 }
 
 messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& estimate) {
-  // Back until the outline, at the heading it stopped with, is clear again (or the back-off
-  // distance is used up, or the outline a few centimetres further back would come within
-  // stop_clearance of what is behind: reversing is checked like driving forward).
+  // Back until the outline, at the heading it stopped with, is clear again (after an obstacle
+  // stop) or the back-off distance is used up, or until the outline a few centimetres further
+  // back would come within stop_clearance of what is behind (reversing is checked like driving
+  // forward).
   messages::BaseVelocityCommand command;
   const double moved = std::hypot(estimate.x - backoff_start_.x, estimate.y - backoff_start_.y);
   constexpr double kLookBehind = 0.05;  // m: a little more than one update's travel backwards
@@ -240,7 +242,7 @@ messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& esti
                      estimate.y - kLookBehind * std::sin(estimate.yaw), estimate.yaw};
   const double here = OutlineClearance({estimate.x, estimate.y, backoff_start_.yaw}, parameters_.resume_clearance);
   const double there = OutlineClearance(behind, parameters_.resume_clearance);
-  if (here >= parameters_.resume_clearance || moved >= parameters_.max_backoff ||
+  if ((backoff_until_clear_ && here >= parameters_.resume_clearance) || moved >= parameters_.max_backoff ||
       (there < parameters_.stop_clearance && there < OutlineClearance(estimate) - 1e-3)) {
     Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
     mode_ = Mode::kIdle;
@@ -321,6 +323,7 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
       return stop;
     }
     backoff_start_ = {estimate.x, estimate.y, estimate.yaw};
+    backoff_until_clear_ = true;
     mode_ = Mode::kBackingOff;
     return stop;
   }

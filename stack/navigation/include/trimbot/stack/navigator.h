@@ -134,8 +134,9 @@ class Navigator {
   Mode mode_ = Mode::kIdle;
   int recoveries_ = 0;
   int plan_failures_ = 0;
-  Pose2 backoff_start_;      // where the back-off started, and the heading it stopped with
-  std::deque<Pose2> trail_;  // the way the robot came, newest last (RecordTrail)
+  Pose2 backoff_start_;              // where the back-off started, and the heading it stopped with
+  bool backoff_until_clear_ = true;  // an obstacle stop's back-off (a failed plan's: the whole max_backoff)
+  std::deque<Pose2> trail_;          // the way the robot came, newest last (RecordTrail)
   std::vector<NavigationEvent> events_;
   double planning_seconds_ = 0.0;
   bool costmap_changed_ = false;
