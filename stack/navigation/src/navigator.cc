@@ -242,7 +242,10 @@ messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& esti
                      estimate.y - kLookBehind * std::sin(estimate.yaw), estimate.yaw};
   const double here = OutlineClearance({estimate.x, estimate.y, backoff_start_.yaw}, parameters_.resume_clearance);
   const double there = OutlineClearance(behind, parameters_.resume_clearance);
-  if ((backoff_until_clear_ && here >= parameters_.resume_clearance) || moved >= parameters_.max_backoff ||
+  // After a failed plan the way it came is backed the whole max_backoff, but straight back (blind
+  // to where it leads) only until clear.
+  const bool until_clear = backoff_until_clear_ || trail_.empty();
+  if ((until_clear && here >= parameters_.resume_clearance) || moved >= parameters_.max_backoff ||
       (there < parameters_.stop_clearance && there < OutlineClearance(estimate) - 1e-3)) {
     Emit(stamp, NavigationEvent::Type::kRecovered, std::to_string(moved) + " m back");
     mode_ = Mode::kIdle;
