@@ -47,6 +47,17 @@ std::string SmokeVariant(const std::string& name, const std::string& replace, co
   return testing::WriteTempFile(name, text);
 }
 
+// Loading the scenario at `path` is refused with an InputError naming `file` and the `problem`.
+void ExpectLoadError(const std::string& path, const std::string& file, const std::string& problem) {
+  try {
+    Scenario::Load(path);
+    ADD_FAILURE() << "accepted: " << path;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scenario, TheRealRobotsTrialSetsLoad) {
   for (const std::string name : {"rectangle", "hourglass"}) {
     const Scenario s = Scenario::Load(testing::SourcePath("scenarios/navigation/" + name + ".yaml"));
@@ -179,13 +190,7 @@ TEST(PriorKnowledge, ASurveyDrawnPerTrialTakesTheTrialsSeed) {
   const std::string text = testing::ReadText(testing::SourcePath("scenarios/navigation/narrow_gap.yaml"));
   const std::string seeded = testing::WriteTempFile(
       "per_trial_seed.yaml", std::regex_replace(text, std::regex("per_trial: true"), "per_trial: true, seed: 3"));
-  try {
-    Scenario::Load(seeded);
-    ADD_FAILURE() << "a per-trial survey with its own seed was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("per_trial_seed.yaml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("seed"), std::string::npos) << e.what();
-  }
+  ExpectLoadError(seeded, "per_trial_seed.yaml", "seed");
 }
 
 // The stack starts from the true start plus the seeded placement error, and reads a calibration
@@ -517,13 +522,7 @@ TEST(Scenario, StartsAndGoalsThatCannotBeAreRefusedNamingTheObject) {
 TEST(Scenario, ABushGoalTakesNoHeading) {
   const std::string path =
       SmokeVariant("bush_heading.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{approach_bush: 3, yaw_deg: 90}");
-  try {
-    Scenario::Load(path);
-    ADD_FAILURE() << "a bush goal with a heading was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("bush_heading.yaml"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("yaw_deg"), std::string::npos) << e.what();
-  }
+  ExpectLoadError(path, "bush_heading.yaml", "a bush goal's heading");
 }
 
 // The suite's goal rule never asks the planner: uniform over the cells at least the outline's
