@@ -44,7 +44,7 @@ GoalResult Goal(double x, double y, bool reached) {
   GoalResult g;
   g.x = x;
   g.y = y;
-  g.reached = reached;
+  g.reached = g.reached_as_asked = reached;
   g.arrival_time = reached ? 42.5 : -1.0;
   g.final_error_m = reached ? 0.12 : -1.0;
   return g;
@@ -149,6 +149,8 @@ std::vector<TrialResult> ThreeTrials() {
   good.status = "completed";
   good.success = true;
   good.goals = {Goal(1, 1, true), Goal(2, 2, true)};
+  good.goals[1].adjusted_by_m = 0.5;  // reached where the robot moved it, 0.5 m from the goal as asked
+  good.goals[1].reached_as_asked = false;
   good.simulated_seconds = 100.0;
   good.wall_seconds = 10.0;
   good.path_length_m = 20.0;
@@ -178,7 +180,8 @@ std::vector<TrialResult> ThreeTrials() {
 TEST(BatchMetrics, RatesMeansAndPooledErrors) {
   const nlohmann::json m = ComputeBatchMetrics(ThreeTrials(), 3);
   EXPECT_DOUBLE_EQ(m["success_rate"].get<double>(), 1.0 / 3.0);
-  EXPECT_DOUBLE_EQ(m["goal_success_rate"].get<double>(), 3.0 / 6.0);  // the crashed trial's 2 goals count
+  EXPECT_DOUBLE_EQ(m["goal_success_rate"].get<double>(), 3.0 / 6.0);           // the crashed trial's 2 goals count
+  EXPECT_DOUBLE_EQ(m["goal_success_rate_as_asked"].get<double>(), 2.0 / 6.0);  // one was moved
   EXPECT_EQ(m["trials_completed"], 1);
   EXPECT_EQ(m["collisions"], 2);
   EXPECT_EQ(m["recoveries"], 3);
@@ -197,7 +200,7 @@ TEST(BatchMetrics, RatesMeansAndPooledErrors) {
   EXPECT_DOUBLE_EQ(m["wheel_odometry_position_error_median_m"].get<double>(), 0.75);
   EXPECT_DOUBLE_EQ(m["wheel_odometry_heading_error_median_deg"].get<double>(), 5.0);
   EXPECT_FALSE(m.contains("pose_fixes_position_error_mean_m"));  // no trial had it
-  EXPECT_EQ(m.size(), 7u + 2u * 7u);
+  EXPECT_EQ(m.size(), 8u + 2u * 7u);
 
   // A planned trial that never ran counts as failed.
   const nlohmann::json four = ComputeBatchMetrics(ThreeTrials(), 4);

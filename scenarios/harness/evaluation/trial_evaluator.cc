@@ -84,6 +84,7 @@ void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const Pl
   goal->final_error_m = std::abs(goal->bush_distance_error_m);
   goal->reached = std::abs(goal->bush_distance_error_m) <= criteria_.bush_distance &&
                   std::abs(goal->bush_bearing_error_deg) <= criteria_.bush_bearing * 180.0 / M_PI;
+  goal->reached_as_asked = goal->reached;  // a bush goal is judged at the bush itself
 }
 
 TrialEvaluator::PlanarPose TrialEvaluator::Planar(double t, const Eigen::Isometry3d& pose) {
@@ -245,6 +246,7 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
         goal.final_heading_error_deg = error * 180.0 / M_PI;
         goal.reached = goal.reached && std::abs(error) <= criteria_.yaw_tolerance;
       }
+      goal.reached_as_asked = goal.reached && std::hypot(truth.x - goal.x, truth.y - goal.y) <= criteria_.tolerance;
     }
   }
 }

@@ -46,6 +46,7 @@ struct GoalResult {
   // at (within its goal_search_radius): arrival is judged there, and the move is reported.
   double adjusted_by_m = 0.0;         // 0: the goal as asked
   double used_x = 0.0, used_y = 0.0;  // the goal navigated to (as asked, or adjusted)
+  bool reached_as_asked = false;      // reached, and within the tolerance of the goal as asked
   // A goal with a heading: the true heading's difference to it at the declared arrival (reached:
   // also within the scenario's goal_yaw_tolerance).
   std::optional<double> yaw_deg;                  // the goal's heading

@@ -257,9 +257,9 @@ RobotReference ReadRobotReference(const YamlMap& map) {
 
 bool IsKnownMetric(const std::string& name) {
   static const std::set<std::string> kMetrics = [] {
-    std::set<std::string> names = {"success_rate",       "goal_success_rate", "trials_completed",
-                                   "collisions",         "recoveries",        "mean_trial_seconds",
-                                   "mean_path_length_m", "localization_rate", "min_clearance_m"};
+    std::set<std::string> names = {
+        "success_rate", "goal_success_rate",  "trials_completed",   "goal_success_rate_as_asked", "collisions",
+        "recoveries",   "mean_trial_seconds", "mean_path_length_m", "localization_rate",          "min_clearance_m"};
     names.insert({"visual_frame_success_rate", "visual_frame_rate_hz", "ekf_nees_mean", "ekf_nees_within_95_rate",
                   "pose_fixes_nees_mean", "pose_fixes_nees_within_95_rate"});
     names.insert({"bush_goals", "bush_frames_1_3m", "bush_frame_found_rate", "bush_frame_within_rate"});
