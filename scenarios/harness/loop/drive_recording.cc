@@ -51,13 +51,13 @@ void CheckOrder(const std::string& path, double previous, double stamp, int line
   }
 }
 
-std::string FrameFolder(const std::string& dir, long index) {
+}  // namespace
+
+std::string RecordedFrameFolder(const std::string& dir, long index) {
   std::ostringstream name;
   name << dir << "/frames/" << std::setw(6) << std::setfill('0') << index;
   return name.str();
 }
-
-}  // namespace
 
 DriveRecording DriveRecording::Load(const std::string& dir) {
   DriveRecording recording;
@@ -100,7 +100,7 @@ std::optional<messages::RingFrame> DriveRecording::LoadFrame(const RecordedRingF
   messages::RingFrame ring;
   ring.stamp = frame.stamp;
   for (int i = 0; i < cameras; ++i) {
-    const std::string path = FrameFolder(dir_, frame.index) + "/cam" + std::to_string(i) + ".png";
+    const std::string path = RecordedFrameFolder(dir_, frame.index) + "/cam" + std::to_string(i) + ".png";
     const cv::Mat bgr = cv::imread(path, cv::IMREAD_COLOR);
     if (bgr.empty()) {
       *gap = path + ": missing or not an image";

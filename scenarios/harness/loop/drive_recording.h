@@ -12,6 +12,10 @@
 
 namespace trimbot::scenarios {
 
+// `dir`/frames/NNNNNN: where a drive folder holds ring frame `index`'s images (RunLog writes them,
+// DriveRecording reads them).
+std::string RecordedFrameFolder(const std::string& dir, long index);
+
 struct RecordedRingFrame {
   long index = 0;
   double stamp = 0.0;  // s, robot time

@@ -1,21 +1,14 @@
 #include "reports/run_log.h"
 
 #include <cstdio>
-#include <iomanip>
-#include <sstream>
 
 #include "evaluation/tum_trajectory.h"
+#include "loop/drive_recording.h"
 #include "reports/output_files.h"
 #include "trimbot/common/atomic_file.h"
 
 namespace trimbot::scenarios {
 namespace {
-
-std::string FrameDir(const std::string& out, long frame) {
-  std::ostringstream name;
-  name << out << "/frames/" << std::setw(6) << std::setfill('0') << frame;
-  return name.str();
-}
 
 void SaveRing(const messages::RingFrame& frame, const sim::RingTruth& truth, const std::string& dir) {
   for (size_t i = 0; i < frame.images.size(); ++i) {
@@ -87,7 +80,7 @@ void RunLog::LogRing(const StepView& step) {
   }
   const bool save = frames_ % save_every_ == 0;
   if (save) {
-    SaveRing(frame, truth, FrameDir(out_, frames_));
+    SaveRing(frame, truth, RecordedFrameFolder(out_, frames_));
     ++saved_frames_;
   }
   std::snprintf(line, sizeof(line), "%ld,%.6f,%d\n", frames_, frame.stamp, save ? 1 : 0);

@@ -196,6 +196,35 @@ struct MappingDrive {
   garden::Garden surveyed;  // the garden as the user surveyed it (its errors included)
 };
 
+// What the user knows of a drive plan's drive (played, or recorded): the stated start, put down
+// near, not at, it; the plan's garden surveyed once with the default survey, seeded by the drive's
+// seed.
+struct KnownStart {
+  Pose2 believed_start;
+  garden::Garden surveyed;
+};
+KnownStart KnownFromPlan(const Setting& setting, const garden::Garden& built, const std::string& source) {
+  Survey survey;
+  survey.seed = setting.seed;
+  return {BelievedPose(setting.start, kInitialPositionSigma, kInitialYawSigma, setting.seed),
+          SurveyedGarden(built, survey, source)};
+}
+
+// The camera calibration the robot's stack reads (the rendering uses the true one).
+robot::CameraRig StackCameraRig(const MapBuildOptions& options) {
+  return CalibratedRig(robot::LoadCameraRig(options.paths.robot_files()), options.recipe.calibration_error);
+}
+
+// The log builder's odometry: the robot's IMU and wheel ticks, from the believed start.
+stack::InertialOdometry LogOdometry(const ProjectPaths& paths, const stack::EkfParameters& ekf,
+                                    const Pose2& believed_start) {
+  const robot::RobotDescription description = robot::RobotDescription::Load(paths.robot_files().urdf);
+  return stack::InertialOdometry(
+      ekf, description.drive(),
+      robot::RobotParameters::Load(paths.robot_files().robot_parameters).wheel_encoders.ticks_per_revolution, 0.0,
+      believed_start);
+}
+
 std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
   auto drive = std::make_unique<MappingDrive>();
   stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
@@ -207,12 +236,10 @@ std::unique_ptr<MappingDrive> LoadMappingDrive(const MapBuildOptions& options) {
     drive->duration = std::min(drive->plan->duration(), options.recipe.seconds.value_or(drive->plan->duration()));
     drive->pilot = std::make_unique<DrivePlanPlayer>(*drive->plan, drive->duration);
     drive->ekf = parameters.ekf;
-    // The plan states where the robot starts; it is put down near, not at, that point.
-    drive->believed_start =
-        BelievedPose(drive->setting.start, kInitialPositionSigma, kInitialYawSigma, drive->setting.seed);
-    Survey survey;
-    survey.seed = drive->setting.seed;
-    drive->surveyed = SurveyedGarden(LoadGarden(drive->setting, options.paths), survey, options.recipe.plan_path);
+    KnownStart known =
+        KnownFromPlan(drive->setting, LoadGarden(drive->setting, options.paths), options.recipe.plan_path);
+    drive->believed_start = known.believed_start;
+    drive->surveyed = std::move(known.surveyed);
     return drive;
   }
   drive->scenario = Scenario::Load(options.recipe.plan_path);
@@ -376,19 +403,13 @@ int RunMapBuildFromRecording(const MapBuildOptions& options) {
   const double until = options.recipe.seconds.value_or(std::numeric_limits<double>::infinity());
   std::filesystem::create_directories(options.out_dir);
   const stack::StackParameters parameters = stack::StackParameters::Load(options.paths.robot_files().stack_parameters);
-  const robot::CameraRig rig =
-      CalibratedRig(robot::LoadCameraRig(options.paths.robot_files()), options.recipe.calibration_error);
+  const robot::CameraRig rig = StackCameraRig(options);
   visual_localization::MapBuilder builder(
       rig, MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(parameters.visual.descriptor)));
   const garden::Garden garden = LoadGarden(setting, options.paths);
-  Survey survey;
-  survey.seed = setting.seed;
-  builder.SetSurveyedShapes(SurveyedShapes(SurveyedGarden(garden, survey, recording.plan().source)));
-  const robot::RobotDescription description = robot::RobotDescription::Load(options.paths.robot_files().urdf);
-  stack::InertialOdometry odometry(
-      parameters.ekf, description.drive(),
-      robot::RobotParameters::Load(options.paths.robot_files().robot_parameters).wheel_encoders.ticks_per_revolution,
-      0.0, BelievedPose(setting.start, kInitialPositionSigma, kInitialYawSigma, setting.seed));
+  const KnownStart known = KnownFromPlan(setting, garden, recording.plan().source);
+  builder.SetSurveyedShapes(SurveyedShapes(known.surveyed));
+  stack::InertialOdometry odometry = LogOdometry(options.paths, parameters.ekf, known.believed_start);
 
   std::cout << "[map] replaying " << dir << ": " << recording.frames().size() << " ring frames" << std::endl;
   std::vector<double> keyframe_stamps;
@@ -448,18 +469,13 @@ int RunMapBuild(const MapBuildOptions& options) {
   sim::Simulator simulator(MappingSimulatorConfig(options, setting));
 
   // The map is made with the calibration the robot's stack reads, as the real one was.
-  const robot::CameraRig rig =
-      CalibratedRig(robot::LoadCameraRig(options.paths.robot_files()), options.recipe.calibration_error);
+  const robot::CameraRig rig = StackCameraRig(options);
   const visual_localization::MapBuilderOptions builder_options =
       MapBuilderOptionsFor(options.recipe, options.recipe.descriptor.value_or(drive->descriptor));
   visual_localization::MapBuilder builder(rig, builder_options);
   const bool from_log = builder_options.poses == visual_localization::KeyframePoses::kOdometry;
   SurveyPoses survey(setting.seed, builder_options.survey_position_sigma, builder_options.survey_rotation_sigma);
-  const robot::RobotDescription description = robot::RobotDescription::Load(options.paths.robot_files().urdf);
-  stack::InertialOdometry odometry(
-      drive->ekf, description.drive(),
-      robot::RobotParameters::Load(options.paths.robot_files().robot_parameters).wheel_encoders.ticks_per_revolution,
-      0.0, drive->believed_start);
+  stack::InertialOdometry odometry = LogOdometry(options.paths, drive->ekf, drive->believed_start);
   if (from_log) builder.SetSurveyedShapes(SurveyedShapes(drive->surveyed));
   SurveyRecorder survey_recorder(builder, survey);
   LogRecorder log_recorder(builder, odometry);

@@ -215,10 +215,19 @@ double AngleBetween(double to, double from) { return std::remainder(to - from, 2
 
 }  // namespace
 
-void Navigator::RecordTrail(const Pose2& estimate) {
+void Navigator::DropTrailIfJumped(const Pose2& estimate) {
   if (!trail_.empty() && std::hypot(estimate.x - trail_.back().x, estimate.y - trail_.back().y) > kTrailJump) {
     trail_.clear();
   }
+}
+
+Pose2 Navigator::TurnedAhead(const Pose2& estimate, double turn_left) const {
+  return {estimate.x, estimate.y,
+          estimate.yaw + std::copysign(std::min(parameters_.turn_check_angle, std::abs(turn_left)), turn_left)};
+}
+
+void Navigator::RecordTrail(const Pose2& estimate) {
+  DropTrailIfJumped(estimate);
   if (!trail_.empty()) {
     const Pose2& last = trail_.back();
     if (std::hypot(estimate.x - last.x, estimate.y - last.y) < kTrailStep &&
@@ -257,9 +266,7 @@ messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& esti
   // turn back that would come within stop_clearance (the trail no longer fits the estimate):
   // straight back.
   const Eigen::Vector2d heading(std::cos(estimate.yaw), std::sin(estimate.yaw));
-  if (!trail_.empty() && std::hypot(estimate.x - trail_.back().x, estimate.y - trail_.back().y) > kTrailJump) {
-    trail_.clear();
-  }
+  DropTrailIfJumped(estimate);
   while (!trail_.empty()) {
     const Eigen::Vector2d to(trail_.back().x - estimate.x, trail_.back().y - estimate.y);
     if (to.norm() >= kTrailReached && to.dot(heading) <= 0.0) break;
@@ -270,9 +277,8 @@ messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& esti
     const double error = AngleBetween(std::atan2(away.y(), away.x()), estimate.yaw);
     const FollowerParameters& follower = parameters_.follower;
     const bool aligned = std::abs(error) < follower.align_tolerance;
-    const Pose2 turned{estimate.x, estimate.y,
-                       estimate.yaw + std::copysign(std::min(parameters_.turn_check_angle, std::abs(error)), error)};
-    if (aligned || OutlineClearance(turned, parameters_.stop_clearance) >= parameters_.stop_clearance) {
+    if (aligned ||
+        OutlineClearance(TurnedAhead(estimate, error), parameters_.stop_clearance) >= parameters_.stop_clearance) {
       command.angular =
           std::clamp(follower.heading_gain * error, -follower.max_angular_speed, follower.max_angular_speed);
       if (aligned) command.linear = -parameters_.backoff_speed;
@@ -312,9 +318,7 @@ messages::BaseVelocityCommand Navigator::Update(double stamp, const Pose2& estim
   // ends if sooner: a small turn lining up in a narrow passage must not be stopped for what a
   // bigger one would hit): stop and back off.
   const bool turning_in_place = follow.command.linear == 0.0 && follow.command.angular != 0.0;
-  Pose2 turned = estimate;
-  turned.yaw +=
-      std::copysign(std::min(parameters_.turn_check_angle, std::abs(follow.turn_left)), follow.command.angular);
+  const Pose2 turned = TurnedAhead(estimate, follow.turn_left);
   const bool too_close =
       (follow.command.linear > 0.0 &&
        OutlineClearance(estimate, parameters_.stop_clearance) < parameters_.stop_clearance) ||

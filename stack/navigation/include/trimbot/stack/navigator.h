@@ -112,6 +112,10 @@ class Navigator {
   void PlanToCurrentGoal(double stamp, const Pose2& estimate);
   // Where the robot drives (by its estimate): appended to the trail it backs out along.
   void RecordTrail(const Pose2& estimate);
+  // Drops the trail when the estimate has jumped away from it (a fix corrected it).
+  void DropTrailIfJumped(const Pose2& estimate);
+  // The pose a turn on the spot checks: `turn_left` (rad, signed) ahead, at most turn_check_angle.
+  Pose2 TurnedAhead(const Pose2& estimate, double turn_left) const;
   // The back-off after an obstacle stop or a failed plan: the way it came, in reverse.
   messages::BaseVelocityCommand BackOff(double stamp, const Pose2& estimate);
   void GiveUpGoal(double stamp, const std::string& why);
