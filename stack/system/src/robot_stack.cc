@@ -52,6 +52,7 @@ std::unique_ptr<visual_localization::VisualLocalizer> MakeVisualLocalizer(const 
   options.keyframes = v.keyframes;
   options.prior_radius = v.prior_radius;
   options.pose.min_inliers = v.min_inliers;
+  options.pose.min_inlier_ratio = v.min_inlier_ratio;
   if (v.left_cameras_only) {
     for (const auto& pair : rig.StereoPairs()) options.cameras.push_back(pair.left);
     std::sort(options.cameras.begin(), options.cameras.end());

@@ -88,6 +88,7 @@ void ReadVisual(Reader& r, VisualLocalizationParameters& p) {
   r.Integer("keyframes", &p.keyframes, 1, 1000);
   r.Number("prior_radius", &p.prior_radius, 0.1, 1000.0, "m");
   r.Integer("min_inliers", &p.min_inliers, 4, 100000);
+  r.Number("min_inlier_ratio", &p.min_inlier_ratio, 0.0, 1.0);
   r.Number("max_position_sigma", &p.max_position_sigma, 0.01, 1000.0, "m");
   if (p.latency_max < p.latency_median) r.map().Fail("latency_max", "must be at least latency_median");
 }

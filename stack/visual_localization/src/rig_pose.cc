@@ -101,6 +101,12 @@ RigPoseResult EstimateRigPose(const std::vector<Correspondence>& correspondences
     result.failure = "refinement left " + std::to_string(result.inliers.size()) + " inliers";
     return result;
   }
+  if (static_cast<double>(result.inliers.size()) <
+      options.min_inlier_ratio * static_cast<double>(correspondences.size())) {
+    result.failure = std::to_string(result.inliers.size()) + " inliers of " + std::to_string(correspondences.size()) +
+                     " correspondences, under the minimum ratio " + std::to_string(options.min_inlier_ratio);
+    return result;
+  }
   result.covariance =
       Covariance(correspondences, result.inliers, T_base_camera, result.T_map_base, options.angle_sigma);
   result.success = true;

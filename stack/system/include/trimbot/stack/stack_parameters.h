@@ -32,12 +32,13 @@ struct VisualLocalizationParameters {
   double latency_max = 1.5;         // s
   int features = 1000;              // keypoints per camera image
   visual_localization::Descriptor descriptor = visual_localization::Descriptor::kUprightSift;  // the map's too
-  bool left_cameras_only = true;  // the left camera of each stereo pair: the robot's SLAM used
-                                  // one (grey) camera per pair (D3.4 Section 2.3); all: both
-  double image_scale = 0.5;       // resolution the ring is asked for (0.5: 376x240)
-  int keyframes = 20;             // retrieved keyframes whose points are matched
-  double prior_radius = 3.0;      // m around the EKF's position
-  int min_inliers = 12;
+  bool left_cameras_only = true;    // the left camera of each stereo pair: the robot's SLAM used
+                                    // one (grey) camera per pair (D3.4 Section 2.3); all: both
+  double image_scale = 0.5;         // resolution the ring is asked for (0.5: 376x240)
+  int keyframes = 20;               // retrieved keyframes whose points are matched
+  double prior_radius = 3.0;        // m around the EKF's position
+  int min_inliers = 30;             // a fix needs this many inliers ...
+  double min_inlier_ratio = 0.25;   // ... and this share of its matches (COLMAP's defaults)
   double max_position_sigma = 0.5;  // m: with a larger EKF uncertainty the robot stops
 };
 const char* ToString(LocalizationSource source);

@@ -20,6 +20,9 @@ struct RigPoseOptions {
   double angle_sigma = 0.002;   // rad: the bearings' noise, for the covariance
   int max_iterations = 500;
   int min_inliers = 12;
+  // Inliers / correspondences below this: no pose (0: not checked). A consistent pose supported by
+  // a small share of the matches is a wrong place more often than a right one (see stack.yaml).
+  double min_inlier_ratio = 0.0;
 };
 
 struct RigPoseResult {
