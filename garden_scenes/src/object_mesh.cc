@@ -7,6 +7,7 @@
 
 #include "trimbot/common/random.h"
 #include "trimbot/garden/conditions.h"
+#include "trimbot/garden/foliage.h"
 #include "trimbot/garden/textures.h"
 
 namespace trimbot::garden {
@@ -25,13 +26,6 @@ double LatticeValue(std::uint64_t seed, long x, long y, long z) {
 void Quad(Mesh& mesh, int a, int b, int c, int d) {
   mesh.faces.push_back({a, b, c});
   mesh.faces.push_back({a, c, d});
-}
-
-// Signed superellipsoid radius along a unit direction: horizontal exponent n, vertical m.
-double SuperRadius(const Eigen::Vector3d& d, const Eigen::Vector3d& half, double n, double m) {
-  const double horizontal =
-      std::pow(std::pow(std::abs(d.x() / half.x()), n) + std::pow(std::abs(d.y() / half.y()), n), m / n);
-  return 1.0 / std::pow(horizontal + std::pow(std::abs(d.z() / half.z()), m), 1.0 / m);
 }
 
 Mesh CylinderMesh(const Eigen::Vector3d& size, double tile) {
@@ -71,15 +65,10 @@ Mesh CylinderMesh(const Eigen::Vector3d& size, double tile) {
 }
 
 // A superellipsoid of the object's shape (exponent 2 = round, larger = flatter sides), its surface
-// pushed out by leaf clumps (depth) and by growth.
-Mesh SuperellipsoidMesh(const GardenObject& object, std::uint64_t seed, double clump_depth, double growth) {
-  double n = 2.0, m = 2.0;
-  if (object.shape == Shape::kBox) n = m = 6.0;
-  if (object.shape == Shape::kCylinder) m = 6.0;
-  const Eigen::Vector3d half = object.size / 2.0;
-  // Leaf clumps: ~12 cm features on bushes, ~40 cm on tree crowns; outgrowth in ~30 cm shoots.
-  const double clump_scale = object.object_class == ObjectClass::kTree ? 0.4 : 0.12;
-  const std::uint64_t object_seed = StreamSeed(seed, "foliage/" + std::to_string(object.id));
+// where FoliageGrowth puts the leaves (the target pushed out by leaf clumps and growth).
+Mesh SuperellipsoidMesh(const GardenObject& object, std::uint64_t seed, double growth) {
+  const FoliageGrowth foliage(object, seed, growth);
+  const Eigen::Vector3d half = foliage.target().half;
   const double tile = TileSize(MaterialOf(object.object_class));
 
   Mesh mesh;
@@ -90,13 +79,8 @@ Mesh SuperellipsoidMesh(const GardenObject& object, std::uint64_t seed, double c
       const double azimuth = 2.0 * M_PI * s / kSegments;
       const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
                               std::cos(polar));
-      const Eigen::Vector3d surface = d * SuperRadius(d, half, n, m);
-      const double clumps = ValueNoise(object_seed, surface / clump_scale) * 0.7 +
-                            ValueNoise(object_seed + 1, surface / (clump_scale * 0.4)) * 0.3;
-      const double shoots = std::max(0.0, ValueNoise(object_seed + 2, surface / 0.3));  // outgrowth in patches
-      double outward = clump_depth * clumps + growth * kMaxGrowth * (0.4 + 1.2 * shoots);
-      // Never cut into the bottom (it sits on the ground or its stem).
-      Eigen::Vector3d p = surface + d * outward;
+      // Never below the bottom (it sits on the ground or its stem).
+      Eigen::Vector3d p = foliage.SurfacePoint(d);
       p.z() = std::max(p.z(), -half.z());
       mesh.vertices.push_back(p + Eigen::Vector3d(0, 0, half.z()));
       const double circumference = M_PI * (half.x() + half.y());
@@ -215,12 +199,12 @@ std::vector<Mesh> LawnMeshes(const Eigen::Vector2d& min, const Eigen::Vector2d& 
 
 Mesh ObjectMesh(const GardenObject& object, std::uint64_t seed, double growth) {
   if (IsFoliage(object.object_class)) {
-    return SuperellipsoidMesh(object, seed, object.object_class == ObjectClass::kTree ? 0.12 : 0.025, growth);
+    return SuperellipsoidMesh(object, seed, growth);
   }
   const double tile = TileSize(MaterialOf(object.object_class));
   switch (object.shape) {
     case Shape::kEllipsoid:
-      return SuperellipsoidMesh(object, seed, 0.0, 0.0);
+      return SuperellipsoidMesh(object, seed, 0.0);
     case Shape::kCylinder:
       return CylinderMesh(object.size, tile);
     case Shape::kBox:

@@ -1,0 +1,106 @@
+#pragma once
+// A topiary's foliage as ground truth that can be cut. The target is the trimmed shape of the
+// garden file (a superellipsoid: a ball or ellipsoid, a rounded cylinder, a rounded box); the
+// leaves lie on a surface displaced from it by leaf clumps and by the season's outgrowth (the
+// surface ObjectMesh renders). Foliage keeps that surface as a radial height field over directions
+// from the shape's centre: each direction is a column of foliage from the centre out to its radius.
+// A blade disc sweeping through a column severs what lies beyond, so cutting shortens columns;
+// what stays is measured against the target as van Marrewijk et al. (Biosystems Engineering 214,
+// 2022) measured the robot's cuts: the share of the surface within 2 cm of the target.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "trimbot/garden/garden.h"
+
+namespace trimbot::garden {
+
+// A superellipsoid |x/a|^n + |y/b|^n)^(m/n) + |z/c|^m = 1 about the shape's centre.
+struct Superellipsoid {
+  Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5);  // m: semi-axes a, b, c
+  double horizontal_exponent = 2.0;                       // n: 2 round, larger flatter sides
+  double vertical_exponent = 2.0;                         // m
+
+  // Distance from the centre to the surface along a unit direction.
+  double Radius(const Eigen::Vector3d& direction) const;
+  // Outward unit normal at a point on (or near) the surface.
+  Eigen::Vector3d Normal(const Eigen::Vector3d& point) const;
+  // Volume enclosed, m^3.
+  double Volume() const;
+};
+
+// The trimmed shape of a garden object (ball, ellipsoid: exponents 2; cylinder: vertical 6; box: 6).
+Superellipsoid TargetShape(const GardenObject& object);
+
+// Where the leaves are along a direction from the shape's centre: the target's surface pushed out
+// by leaf clumps (`clump_depth`) and by the season's outgrowth (`growth` in 0..1, conditions.h), in
+// seeded noise of the garden's appearance; never below the shape's bottom. One formula for the
+// rendered mesh and the foliage that is cut.
+class FoliageGrowth {
+ public:
+  FoliageGrowth(const GardenObject& object, std::uint64_t appearance_seed, double growth);
+  Eigen::Vector3d SurfacePoint(const Eigen::Vector3d& direction) const;  // in the shape's centre frame
+  const Superellipsoid& target() const { return target_; }
+
+ private:
+  Superellipsoid target_;
+  std::uint64_t seed_;
+  double clump_depth_, clump_scale_, growth_;
+};
+
+// A blade's cutting disc: centre and axis (the disc's normal) in the map frame.
+struct BladeDisc {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double radius = 0.1;  // m
+};
+
+struct CutQuality {
+  double surface_within_tolerance = 0.0;  // share of the foliage surface within the tolerance of the target
+  double overgrowth_volume = 0.0;         // m^3 of foliage outside the target
+  double overcut_volume = 0.0;            // m^3 of the target without foliage (cut into)
+  double target_volume = 0.0;             // m^3
+  double max_overgrowth = 0.0;            // m: the largest radial excess over the target
+};
+
+class Foliage {
+ public:
+  // The object's foliage grown for `growth`, on rings x segments directions (polar x azimuth).
+  static Foliage Grown(const GardenObject& object, std::uint64_t appearance_seed, double growth, int rings = 90,
+                       int segments = 180);
+
+  // Removes what the disc severs moving from `from` to `to`: translated linearly, its axis turned
+  // in steps of at most 1 deg (each step swept with its mean axis). A column the swept disc
+  // crosses ends where the blade first met it.
+  void Cut(const BladeDisc& from, const BladeDisc& to);
+
+  // Against the target, the surface's distance measured along the target's normal.
+  CutQuality Measure(double tolerance = 0.02) const;
+  // The leaf surface's points in the map frame (one per column).
+  std::vector<Eigen::Vector3d> SurfacePoints() const;
+  // Binary little-endian PLY of the surface points with their signed distance to the target (m,
+  // property `distance`), written atomically.
+  void WritePly(const std::string& path) const;
+
+  int columns() const { return static_cast<int>(radius_.size()); }
+  const Eigen::Vector3d& direction(int i) const { return direction_[static_cast<std::size_t>(i)]; }
+  double radius(int i) const { return radius_[static_cast<std::size_t>(i)]; }
+  double target_radius(int i) const { return target_radius_[static_cast<std::size_t>(i)]; }
+  // Pose of the shape's centre frame in the map frame.
+  const Eigen::Isometry3d& pose() const { return T_map_centre_; }
+
+ private:
+  void CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& axis,
+                     double radius);
+
+  Superellipsoid target_;
+  Eigen::Isometry3d T_map_centre_ = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> direction_;  // unit, in the centre frame
+  std::vector<double> solid_angle_;         // sr per column
+  std::vector<double> radius_;              // m: where the foliage ends
+  std::vector<double> target_radius_;       // m: where the target's surface is
+  std::vector<double> floor_radius_;        // m: the bottom plane along the column (foliage never below)
+};
+
+}  // namespace trimbot::garden

@@ -1,0 +1,143 @@
+// Foliage that can be cut (issue 31, deliverable 1): a blade disc's sweep removes exactly the
+// foliage beyond where it crossed each column, and the cut is measured against the target.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "trimbot/garden/foliage.h"
+
+namespace trimbot::garden {
+namespace {
+
+GardenObject Topiary(Shape shape, const Eigen::Vector3d& size) {
+  GardenObject bush;
+  bush.id = 7;
+  bush.object_class = ObjectClass::kTopiary;
+  bush.shape = shape;
+  bush.size = size;
+  bush.position = {1.0, -2.0};
+  bush.yaw = 0.4;
+  return bush;
+}
+
+// Brute force: the first point along column i, in 1 mm steps, that some position of the disc on
+// its way (1000 steps) holds within half a millimetre of its plane.
+double BruteForceCut(const Foliage& foliage, int i, const BladeDisc& from, const BladeDisc& to) {
+  const Eigen::Vector3d axis = from.axis.normalized();
+  for (double s = 0.0; s < foliage.radius(i); s += 0.001) {
+    const Eigen::Vector3d q = foliage.pose() * (s * foliage.direction(i));
+    for (int k = 0; k <= 1000; ++k) {
+      const Eigen::Vector3d c = from.centre + (to.centre - from.centre) * (k / 1000.0);
+      const Eigen::Vector3d v = q - c;
+      if (std::abs(v.dot(axis)) <= 0.0005 && (v - v.dot(axis) * axis).norm() <= from.radius) return s;
+    }
+  }
+  return foliage.radius(i);
+}
+
+TEST(Foliage, ASweepInItsPlaneSeversEveryColumnItCrossesWhereItCrossesIt) {
+  const GardenObject bush = Topiary(Shape::kEllipsoid, {0.7, 0.7, 0.6});
+  Foliage foliage = Foliage::Grown(bush, 5, 0.5, 30, 60);
+  const Foliage before = foliage;
+  // A horizontal disc 0.15 m above the centre, 0.1 m in radius, moving 0.8 m along the map's x.
+  BladeDisc from, to;
+  from.centre = foliage.pose() * Eigen::Vector3d(0.0, 0.0, 0.15) - Eigen::Vector3d(0.4, 0.0, 0.0);
+  to.centre = from.centre + Eigen::Vector3d(0.8, 0.0, 0.0);
+  from.radius = to.radius = 0.1;
+  foliage.Cut(from, to);
+  int cut = 0;
+  for (int i = 0; i < foliage.columns(); ++i) {
+    const Eigen::Vector3d d = foliage.direction(i);
+    double expected = before.radius(i);
+    if (d.z() > 0.0) {
+      // Where the column crosses the disc's plane, and whether the disc's path passed there.
+      const double s = 0.15 / d.z();
+      const Eigen::Vector3d q = foliage.pose() * (s * d);
+      const double along = std::clamp((q - from.centre).x() / 0.8, 0.0, 1.0);
+      if (s < before.radius(i) && (q - (from.centre + along * (to.centre - from.centre))).norm() <= 0.1) expected = s;
+    }
+    EXPECT_NEAR(foliage.radius(i), expected, 1e-9) << "column " << i;
+    cut += foliage.radius(i) < before.radius(i) ? 1 : 0;
+  }
+  EXPECT_GT(cut, 20) << "the sweep crossed the bush";
+  EXPECT_LT(cut, foliage.columns() / 3);
+}
+
+TEST(Foliage, AnObliqueSweepAgreesWithABruteForceSweep) {
+  const GardenObject bush = Topiary(Shape::kBox, {0.6, 0.5, 0.5});
+  Foliage foliage = Foliage::Grown(bush, 9, 1.0, 16, 32);
+  const Foliage before = foliage;
+  // A tilted disc plunging sideways into the bush's top corner: the move has a component along
+  // its axis, so the swept volume is an oblique cylinder.
+  BladeDisc from, to;
+  from.axis = to.axis = Eigen::Vector3d(0.3, 0.2, 1.0).normalized();
+  from.centre = foliage.pose() * Eigen::Vector3d(0.35, 0.0, 0.35);
+  to.centre = foliage.pose() * Eigen::Vector3d(0.05, 0.1, 0.15);
+  from.radius = to.radius = 0.12;
+  foliage.Cut(from, to);
+  int cut = 0;
+  for (int i = 0; i < foliage.columns(); ++i) {
+    EXPECT_NEAR(foliage.radius(i), BruteForceCut(before, i, from, to), 0.004) << "column " << i;
+    cut += foliage.radius(i) < before.radius(i) - 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(cut, 5);
+}
+
+TEST(Foliage, CuttingOffTheCrownIsMeasuredAsOvercut) {
+  const GardenObject bush = Topiary(Shape::kEllipsoid, {0.8, 0.6, 0.5});
+  Foliage foliage = Foliage::Grown(bush, 3, 0.6);
+  const CutQuality grown = foliage.Measure();
+  const double a = 0.4, b = 0.3, c = 0.25, h = 0.1;
+  const double ellipsoid = 4.0 / 3.0 * M_PI * a * b * c;
+  EXPECT_NEAR(grown.target_volume, ellipsoid, 0.002 * ellipsoid);
+  EXPECT_GT(grown.overgrowth_volume, 0.0);
+  EXPECT_LT(grown.overcut_volume, 0.02 * ellipsoid) << "leaf clumps dip below the target here and there";
+  // A blade larger than the bush, level 0.1 m above its centre, passing right across: the target's
+  // cap above that plane is over-cut, what grew below it stays.
+  BladeDisc from, to;
+  from.centre = foliage.pose() * Eigen::Vector3d(-1.0, 0.0, h);
+  to.centre = foliage.pose() * Eigen::Vector3d(1.0, 0.0, h);
+  from.radius = to.radius = 1.0;
+  foliage.Cut(from, to);
+  const CutQuality capped = foliage.Measure();
+  const double cap = M_PI * a * b * (c - h) * (c - h) * (2.0 * c + h) / (3.0 * c * c);
+  EXPECT_NEAR(capped.overcut_volume, cap, 0.03 * cap);
+  EXPECT_LT(capped.overgrowth_volume, grown.overgrowth_volume);
+  EXPECT_GT(capped.overgrowth_volume, 0.3 * grown.overgrowth_volume);
+  for (int i = 0; i < foliage.columns(); ++i) EXPECT_LE((foliage.radius(i) * foliage.direction(i)).z(), h + 1e-9);
+  std::printf("grown: %.1f %% of the surface within 2 cm, %.1f l overgrowth; capped: %.2f l over-cut (cap %.2f l)\n",
+              100.0 * grown.surface_within_tolerance, 1000.0 * grown.overgrowth_volume, 1000.0 * capped.overcut_volume,
+              1000.0 * cap);
+}
+
+TEST(Foliage, GrowthLowersTheShareOfTheSurfaceNearTheTarget) {
+  for (Shape shape : {Shape::kEllipsoid, Shape::kCylinder, Shape::kBox}) {
+    const GardenObject bush = Topiary(shape, {0.7, 0.7, 0.7});
+    const CutQuality trimmed = Foliage::Grown(bush, 1, 0.0).Measure();
+    const CutQuality grown = Foliage::Grown(bush, 1, 0.5).Measure();
+    EXPECT_GT(trimmed.surface_within_tolerance, 0.9) << "leaf clumps alone stay within 2 cm";
+    EXPECT_LT(grown.surface_within_tolerance, 0.5 * trimmed.surface_within_tolerance);
+    EXPECT_GT(grown.max_overgrowth, 0.4 * 0.5 * 0.15);
+  }
+}
+
+TEST(Foliage, WritesItsSurfaceAsPly) {
+  const Foliage foliage = Foliage::Grown(Topiary(Shape::kCylinder, {0.5, 0.5, 0.8}), 2, 0.3, 10, 20);
+  const std::string path = (std::filesystem::temp_directory_path() / "trimbot_foliage_test.ply").string();
+  foliage.WritePly(path);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t header = bytes.find("end_header\n");
+  ASSERT_NE(header, std::string::npos);
+  EXPECT_NE(bytes.find("element vertex 200"), std::string::npos);
+  EXPECT_EQ(bytes.size() - (header + 11), 200u * 16u);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace trimbot::garden
