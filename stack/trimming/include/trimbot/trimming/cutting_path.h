@@ -1,0 +1,69 @@
+#pragma once
+// The cutting path over a topiary's target shape (reference deliverable D3.4, Section 1.5): blade
+// poses tangent to the target where the arm can reach it from where the base stands, the arm's
+// collision-free inverse-kinematics solutions of each pose as one GTSP cluster (the blade spins,
+// so its roll about its axis is free: several rolls per pose), the edge cost the time of a
+// rest-to-rest joint move between two solutions, and a tour through one solution of every pose.
+// Moves between blade poses are straight joint moves: those the collision check refuses are
+// forbidden and the tour solved again (lazy edge checking: only the edges a tour uses are checked).
+// The moves from the start to the first pose and back from the last are costed as straight moves
+// but not checked: the arm planner plans them round obstacles when they are executed.
+#include <Eigen/Geometry>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "trimbot/arm/arm_kinematics.h"
+#include "trimbot/perception/topiary_fit.h"
+#include "trimbot/trimming/gtsp.h"
+
+namespace trimbot::trimming {
+
+struct CuttingPoseOptions {
+  double spacing = 0.08;          // m between neighbouring blade centres on the target (the blade's
+                                  // 0.1 m disc, overlapping)
+  double max_facing_angle = 1.4;  // rad: surface whose normal turns further from the base is left
+                                  // to another standoff
+  double min_height = 0.05;       // m above the ground for the blade's centre
+};
+
+// Blade poses (the disc's centre on the target's surface, its z axis into the surface, along the
+// inward normal) in the frame of `target` (base_link), facing the base at the origin.
+std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target,
+                                            const CuttingPoseOptions& options = {});
+
+struct CuttingPathOptions {
+  int rolls = 6;                // blade rolls about its axis tried per pose
+  double velocity_scale = 0.5;  // of the URDF's joint velocity limits (as the arm planner's)
+  double acceleration = 1.5;    // rad/s^2 per joint (as the arm planner's)
+  int max_lazy_rounds = 30;     // tours solved again after refused moves, at most
+  GtspSearchOptions search;
+  arm::IkOptions ik;
+};
+
+struct CuttingPath {
+  bool ok = false;
+  std::string failure;                          // when not ok
+  std::vector<Eigen::VectorXd> configurations;  // start, then one per reached pose in visiting order, then start
+  std::vector<int> poses;                       // the pose of each configuration between start and end
+  std::vector<int> unreachable;                 // poses with no collision-free solution
+  double motion_time = 0.0;                     // s: rest-to-rest joint moves along the tour
+  double nearest_neighbour_time = 0.0;          // s: the greedy baseline's tour on the same instance
+  int clusters = 0, nodes = 0;                  // of the GTSP
+  int refused_moves = 0;                        // edges the collision check forbade
+};
+
+// Time of a joint move from rest to rest along a straight joint-space line (trapezoidal speed
+// profile, the slowest joint sets it; continuous joints the short way round).
+double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                     double velocity_scale, double acceleration);
+
+// `valid(q)`: the configuration is free; `free_move(a, b)`: the straight joint move is free.
+// `T_cutter_blade`: the blade's disc in the cutter frame (from the URDF).
+CuttingPath PlanCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                            const Eigen::VectorXd& start, const std::vector<Eigen::Isometry3d>& blade_poses,
+                            const std::function<bool(const Eigen::VectorXd&)>& valid,
+                            const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
+                            const CuttingPathOptions& options = {});
+
+}  // namespace trimbot::trimming

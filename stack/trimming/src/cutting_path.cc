@@ -1,0 +1,220 @@
+#include "trimbot/trimming/cutting_path.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <set>
+#include <utility>
+
+namespace trimbot::trimming {
+namespace {
+
+// Outward unit normal of the target at a point near its surface: the gradient of the radial
+// distance, by central differences (the superellipsoid's own gradient, up to its length).
+Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eigen::Vector3d& p) {
+  constexpr double h = 1e-5;
+  Eigen::Vector3d g;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(k);
+    g(k) = (target.RadialDistance(p + e) - target.RadialDistance(p - e)) / (2.0 * h);
+  }
+  return g.normalized();
+}
+
+// A rotation whose z axis is `z` (unit).
+Eigen::Matrix3d FrameWithZ(const Eigen::Vector3d& z) {
+  const Eigen::Vector3d helper = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d x = helper.cross(z).normalized();
+  Eigen::Matrix3d R;
+  R.col(0) = x;
+  R.col(1) = z.cross(x);
+  R.col(2) = z;
+  return R;
+}
+
+// A sphere the cutter cannot leave: about the first link's origin (on the first joint's axis, so
+// fixed in base_link), of the sum of the distances between consecutive link origins (rigid links,
+// the triangle inequality). Poses outside it are refused without inverse kinematics, which takes
+// its full budget of starts to give up.
+std::pair<Eigen::Vector3d, double> ReachSphere(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& q) {
+  const std::vector<Eigen::Isometry3d> links = kinematics.LinkPoses(q);
+  double reach = 0.0;
+  for (std::size_t i = 1; i < links.size(); ++i) reach += (links[i].translation() - links[i - 1].translation()).norm();
+  return {links.front().translation(), reach};
+}
+
+}  // namespace
+
+std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target, const CuttingPoseOptions& options) {
+  // Directions from the centre on a Fibonacci sphere, as many as the surface holds blade spacings
+  // (the surface of the ellipsoid through the semi-axes, Knud Thomsen's approximation).
+  const Eigen::Vector3d& s = target.half;
+  constexpr double p = 1.6075;
+  const double area =
+      4.0 * M_PI *
+      std::pow((std::pow(s.x() * s.y(), p) + std::pow(s.x() * s.z(), p) + std::pow(s.y() * s.z(), p)) / 3.0, 1.0 / p);
+  const int count = std::max(8, static_cast<int>(std::ceil(area / (options.spacing * options.spacing))));
+  const Eigen::Matrix3d R_yaw = Eigen::AngleAxisd(target.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
+  std::vector<Eigen::Isometry3d> poses;
+  for (int k = 0; k < count; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / count, r = std::sqrt(1.0 - z * z);
+    const Eigen::Vector3d d =
+        R_yaw * Eigen::Vector3d(r * std::cos(golden_angle * k), r * std::sin(golden_angle * k), z);
+    // The surface along d: a point 1 m out along d lies 1 m - radius outside it.
+    const double radius = 1.0 - target.RadialDistance(target.centre + d);
+    const Eigen::Vector3d point = target.centre + radius * d;
+    if (point.z() < options.min_height) continue;
+    const Eigen::Vector3d normal = SurfaceNormal(target, point);
+    const Eigen::Vector3d to_base = (Eigen::Vector3d(0.0, 0.0, point.z()) - point).normalized();
+    if (normal.dot(to_base) < std::cos(options.max_facing_angle)) continue;
+    Eigen::Isometry3d blade = Eigen::Isometry3d::Identity();
+    blade.linear() = FrameWithZ(-normal);
+    blade.translation() = point;
+    poses.push_back(blade);
+  }
+  return poses;
+}
+
+double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                     double velocity_scale, double acceleration) {
+  double time = 0.0;
+  for (int j = 0; j < kinematics.joints(); ++j) {
+    const arm::JointLimit& limit = kinematics.limits()[static_cast<std::size_t>(j)];
+    double d = to(j) - from(j);
+    if (limit.continuous) d = std::remainder(d, 2.0 * M_PI);
+    d = std::abs(d);
+    const double v = velocity_scale * limit.velocity;
+    time = std::max(time, d < v * v / acceleration ? 2.0 * std::sqrt(d / acceleration) : d / v + v / acceleration);
+  }
+  return time;
+}
+
+namespace {
+
+// The GTSP of a cutting path: node 0 the start (its own cluster), then each reachable pose's free
+// solutions over its rolls. Fills `path`'s counts and unreachable poses.
+struct CuttingInstance {
+  GtspInstance gtsp;
+  std::vector<Eigen::VectorXd> nodes;
+  std::vector<int> pose_of_node;
+  std::vector<int> cluster_of_node;
+};
+
+CuttingInstance BuildInstance(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                              const Eigen::VectorXd& start, const std::vector<Eigen::Isometry3d>& blade_poses,
+                              const std::function<bool(const Eigen::VectorXd&)>& valid,
+                              const CuttingPathOptions& options, CuttingPath* path, double* reach_out) {
+  CuttingInstance c;
+  c.nodes = {start};
+  c.pose_of_node = {-1};
+  c.cluster_of_node = {0};
+  c.gtsp.clusters.push_back({0});
+  const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
+  const auto [shoulder, reach] = ReachSphere(kinematics, start);
+  *reach_out = reach;
+  for (std::size_t k = 0; k < blade_poses.size(); ++k) {
+    std::vector<int> cluster;
+    const bool within_reach = ((blade_poses[k] * T_blade_cutter).translation() - shoulder).norm() <= reach;
+    for (int r = 0; within_reach && r < options.rolls; ++r) {
+      const Eigen::Isometry3d blade =
+          blade_poses[k] * Eigen::AngleAxisd(2.0 * M_PI * r / options.rolls, Eigen::Vector3d::UnitZ());
+      for (const Eigen::VectorXd& q : kinematics.InverseKinematics(blade * T_blade_cutter, options.ik).solutions) {
+        if (!valid(q)) continue;
+        cluster.push_back(static_cast<int>(c.nodes.size()));
+        c.nodes.push_back(q);
+        c.pose_of_node.push_back(static_cast<int>(k));
+        c.cluster_of_node.push_back(static_cast<int>(c.gtsp.clusters.size()));
+      }
+    }
+    if (cluster.empty()) {
+      path->unreachable.push_back(static_cast<int>(k));
+    } else {
+      c.gtsp.clusters.push_back(cluster);
+    }
+  }
+  path->clusters = static_cast<int>(c.gtsp.clusters.size()) - 1;
+  path->nodes = static_cast<int>(c.nodes.size()) - 1;
+  const auto n = static_cast<Eigen::Index>(c.nodes.size());
+  c.gtsp.cost.resize(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j)
+      c.gtsp.cost(i, j) =
+          i == j ? 0.0
+                 : JointMoveTime(kinematics, c.nodes[static_cast<std::size_t>(i)], c.nodes[static_cast<std::size_t>(j)],
+                                 options.velocity_scale, options.acceleration);
+  }
+  return c;
+}
+
+// Lazy edge checking: solve, check the tour's moves; where one is refused, check every move
+// between the two poses' solutions (their neighbours collide alike), forbid the refused ones, and
+// solve again. The moves to and from the start are not checked: the arm planner plans them round
+// obstacles when they are executed.
+std::optional<GtspTour> SolveWithFreeMoves(
+    CuttingInstance* c, const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
+    const CuttingPathOptions& options, CuttingPath* path) {
+  std::set<std::pair<int, int>> checked_clusters;
+  const auto check_clusters = [&](int a, int b) {
+    const auto key =
+        std::minmax(c->cluster_of_node[static_cast<std::size_t>(a)], c->cluster_of_node[static_cast<std::size_t>(b)]);
+    if (!checked_clusters.insert(key).second) return;
+    for (int u : c->gtsp.clusters[static_cast<std::size_t>(key.first)]) {
+      for (int v : c->gtsp.clusters[static_cast<std::size_t>(key.second)]) {
+        if (free_move(c->nodes[static_cast<std::size_t>(u)], c->nodes[static_cast<std::size_t>(v)])) continue;
+        c->gtsp.cost(u, v) = c->gtsp.cost(v, u) = std::numeric_limits<double>::infinity();
+        ++path->refused_moves;
+      }
+    }
+  };
+  for (int round = 0; round < options.max_lazy_rounds; ++round) {
+    const GtspTour tour = SolveGtspLargeNeighbourhood(c->gtsp, options.search);
+    if (!tour.Feasible()) break;
+    bool all_free = true;
+    for (std::size_t i = 0; i < tour.nodes.size(); ++i) {
+      const int a = tour.nodes[i], b = tour.nodes[(i + 1) % tour.nodes.size()];
+      if (a == 0 || b == 0) continue;
+      check_clusters(a, b);
+      all_free = all_free && std::isfinite(c->gtsp.cost(a, b));
+    }
+    if (all_free) return tour;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+CuttingPath PlanCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                            const Eigen::VectorXd& start, const std::vector<Eigen::Isometry3d>& blade_poses,
+                            const std::function<bool(const Eigen::VectorXd&)>& valid,
+                            const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
+                            const CuttingPathOptions& options) {
+  CuttingPath path;
+  double reach = 0.0;
+  CuttingInstance c = BuildInstance(kinematics, T_cutter_blade, start, blade_poses, valid, options, &path, &reach);
+  if (path.clusters == 0) {
+    path.failure = "no blade pose of " + std::to_string(blade_poses.size()) +
+                   " has a collision-free arm solution (the arm reaches " + std::to_string(reach) +
+                   " m from its shoulder)";
+    return path;
+  }
+  std::optional<GtspTour> tour = SolveWithFreeMoves(&c, free_move, options, &path);
+  if (!tour) {
+    path.failure = "no tour of free moves through the " + std::to_string(path.clusters) + " reachable poses (" +
+                   std::to_string(path.refused_moves) + " moves refused)";
+    return path;
+  }
+  // The tour from the start round and back to it.
+  std::rotate(tour->nodes.begin(), std::find(tour->nodes.begin(), tour->nodes.end(), 0), tour->nodes.end());
+  for (int node : tour->nodes) {
+    path.configurations.push_back(c.nodes[static_cast<std::size_t>(node)]);
+    if (node != 0) path.poses.push_back(c.pose_of_node[static_cast<std::size_t>(node)]);
+  }
+  path.configurations.push_back(start);
+  path.motion_time = tour->cost;
+  path.nearest_neighbour_time = SolveGtspNearestNeighbour(c.gtsp).cost;
+  path.ok = true;
+  return path;
+}
+
+}  // namespace trimbot::trimming

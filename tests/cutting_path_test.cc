@@ -1,0 +1,120 @@
+// The cutting path over a bush's target shape (issue 31, deliverable 3) with the robot's own arm:
+// blade poses tangent to the target, the arm's free inverse-kinematics solutions as GTSP clusters,
+// a tour of free joint moves through one of each.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "test_support.h"
+#include "trimbot/robot/collision_model.h"
+#include "trimbot/robot/robot_parameters.h"
+#include "trimbot/trimming/cutting_path.h"
+
+namespace trimbot::trimming {
+namespace {
+
+struct Fixture {
+  robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  arm::ArmKinematics kinematics{robot};
+  robot::CollisionModel collision{robot, robot.ArmJointNames()};
+  Eigen::VectorXd home;
+  Eigen::Isometry3d T_cutter_blade;
+  perception::TopiaryShape target;
+
+  // A ball of 0.3 m radius in front of the robot. The arm keeps out of it but for the 2 cm a cut may
+  // go deep and still leave the surface within tolerance (the blade's rim tilts on a joint move).
+  Fixture() {
+    const auto p = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
+    home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
+    T_cutter_blade = robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+    target.centre = {0.95, 0.0, 0.35};
+    target.half = Eigen::Vector3d::Constant(0.3);
+    collision.environment().AddGround("ground", 0.0);
+    collision.environment().AddSphere("target", 0.28, target.centre);
+  }
+  bool Valid(const Eigen::VectorXd& q) const { return !collision.Check(q).collision; }
+  // The straight joint move checked every 0.02 rad (continuous joints the short way round).
+  bool FreeMove(const Eigen::VectorXd& a, const Eigen::VectorXd& b) const {
+    Eigen::VectorXd d = b - a;
+    for (int j = 0; j < 6; ++j) {
+      if (kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = std::remainder(d(j), 2.0 * M_PI);
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.02)));
+    for (int k = 1; k < steps; ++k) {
+      if (!Valid(a + d * (static_cast<double>(k) / steps))) return false;
+    }
+    return Valid(b);
+  }
+};
+
+TEST(CuttingPath, BladePosesLieOnTheTargetFacingTheRobot) {
+  Fixture f;
+  const std::vector<Eigen::Isometry3d> poses = CuttingPoses(f.target);
+  ASSERT_GT(poses.size(), 20u);
+  for (const Eigen::Isometry3d& pose : poses) {
+    EXPECT_NEAR(f.target.RadialDistance(pose.translation()), 0.0, 1e-6);
+    // The blade's axis along the inward normal: for a ball, towards the centre.
+    EXPECT_NEAR(pose.linear().col(2).dot((f.target.centre - pose.translation()).normalized()), 1.0, 1e-6);
+    EXPECT_LT(pose.translation().x(), f.target.centre.x() + 0.3 * std::sin(1.4) + 1e-6) << "faces the robot";
+  }
+}
+
+TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
+  Fixture f;
+  CuttingPoseOptions pose_options;
+  pose_options.spacing = 0.12;
+  CuttingPathOptions options;
+  options.rolls = 4;
+  const std::vector<Eigen::Isometry3d> poses = CuttingPoses(f.target, pose_options);
+  const auto start = std::chrono::steady_clock::now();
+  const CuttingPath path = PlanCuttingPath(
+      f.kinematics, f.T_cutter_blade, f.home, poses, [&](const Eigen::VectorXd& q) { return f.Valid(q); },
+      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); }, options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(path.ok) << path.failure;
+  std::printf(
+      "cutting path: %zu poses, %d reachable (%d arm solutions), %d refused moves; tour %.1f s of joint "
+      "moves, nearest neighbour %.1f s; planned in %.1f s\n",
+      poses.size(), path.clusters, path.nodes, path.refused_moves, path.motion_time, path.nearest_neighbour_time,
+      seconds);
+  EXPECT_EQ(path.clusters + static_cast<int>(path.unreachable.size()), static_cast<int>(poses.size()));
+  EXPECT_GT(path.clusters, static_cast<int>(poses.size()) / 3);
+  ASSERT_EQ(path.configurations.size(), path.poses.size() + 2);
+  EXPECT_EQ(path.configurations.front(), f.home);
+  EXPECT_EQ(path.configurations.back(), f.home);
+  std::vector<int> visits(poses.size(), 0);
+  for (std::size_t i = 0; i < path.poses.size(); ++i) {
+    const int k = path.poses[i];
+    ++visits[static_cast<std::size_t>(k)];
+    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(path.configurations[i + 1]) * f.T_cutter_blade;
+    EXPECT_LT((blade.translation() - poses[static_cast<std::size_t>(k)].translation()).norm(), 1e-3);
+    EXPECT_GT(blade.linear().col(2).dot(poses[static_cast<std::size_t>(k)].linear().col(2)), std::cos(0.01));
+  }
+  for (int k : path.unreachable) EXPECT_EQ(visits[static_cast<std::size_t>(k)], 0);
+  int reached = 0;
+  for (int v : visits) {
+    EXPECT_LE(v, 1);
+    reached += v;
+  }
+  EXPECT_EQ(reached, path.clusters);
+  // Every move between blade poses is free (to and from the start the arm planner plans).
+  for (std::size_t i = 1; i + 2 < path.configurations.size(); ++i)
+    EXPECT_TRUE(f.FreeMove(path.configurations[i], path.configurations[i + 1])) << "move " << i;
+  EXPECT_LE(path.motion_time, path.nearest_neighbour_time);
+}
+
+TEST(CuttingPath, ABushOutOfReachIsAFailureWithTheReason) {
+  Fixture f;
+  perception::TopiaryShape far = f.target;
+  far.centre.x() = 3.0;
+  const CuttingPath path = PlanCuttingPath(
+      f.kinematics, f.T_cutter_blade, f.home, CuttingPoses(far), [&](const Eigen::VectorXd& q) { return f.Valid(q); },
+      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); });
+  EXPECT_FALSE(path.ok);
+  EXPECT_NE(path.failure.find("no blade pose"), std::string::npos) << path.failure;
+}
+
+}  // namespace
+}  // namespace trimbot::trimming
