@@ -240,15 +240,29 @@ TEST(MapBuild, AMapFromARecordedDriveIsWithinItsStatedErrorsAndReportsItsGaps) {
     EXPECT_TRUE(std::regex_search(gap.get<std::string>(), std::regex("00001[5-9]/cam3.png"))) << gap;
   }
 
-  std::string imu = testing::ReadText(recording + "/sensors/imu.csv");
-  imu.insert(imu.find('\n', imu.find('\n') + 1) + 1, "0.01,1,2\n");  // line 3
-  WriteFileAtomically(recording + "/sensors/imu.csv", imu);
+  const std::string imu = testing::ReadText(recording + "/sensors/imu.csv");
+  std::string broken = imu;
+  broken.insert(broken.find('\n', broken.find('\n') + 1) + 1, "0.01,1,2\n");  // line 3
+  WriteFileAtomically(recording + "/sensors/imu.csv", broken);
   try {
     scenarios::RunMapBuild(options);
     ADD_FAILURE() << "a malformed IMU log was accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.file(), recording + "/sensors/imu.csv");
     EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  // An encoder count that is not a whole number.
+  WriteFileAtomically(recording + "/sensors/imu.csv", imu);
+  std::string ticks = testing::ReadText(recording + "/sensors/wheel_ticks.csv");
+  const std::size_t line2 = ticks.find('\n') + 1;
+  ticks.replace(line2, ticks.find('\n', line2) - line2, "0.0,1.5,2");
+  WriteFileAtomically(recording + "/sensors/wheel_ticks.csv", ticks);
+  try {
+    scenarios::RunMapBuild(options);
+    ADD_FAILURE() << "a fractional tick count was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), recording + "/sensors/wheel_ticks.csv");
+    EXPECT_NE(std::string(e.what()).find("line 2: tick count 1.5"), std::string::npos) << e.what();
   }
 }
 
