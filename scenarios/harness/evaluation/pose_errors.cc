@@ -1,4 +1,5 @@
 #include "evaluation/pose_errors.h"
+#include "trimbot/common/pose2.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -18,7 +19,7 @@ double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry
   return (estimate.translation() - truth.translation()).norm();
 }
 
-double AngleDifference(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
+double AngleDifference(double a, double b) { return WrapAngle(a - b); }
 
 double PlanarNees(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance) {
   return error.dot(covariance.ldlt().solve(error));

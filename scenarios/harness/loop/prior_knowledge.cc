@@ -6,6 +6,7 @@
 
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/pose2.h"
 #include "trimbot/common/random.h"
 #include "trimbot/common/rotation.h"
 #include "trimbot/garden/conditions.h"
@@ -143,8 +144,7 @@ Pose2 BelievedStart(const Scenario& scenario, std::uint64_t seed) {
 Pose2 BelievedPose(const Pose2& start, double position_sigma, double yaw_sigma, std::uint64_t seed) {
   Rng rng = MakeRng(seed, "initial_pose");
   const double dx = StandardNormal(rng), dy = StandardNormal(rng), dyaw = StandardNormal(rng);
-  return {start.x + position_sigma * dx, start.y + position_sigma * dy,
-          std::remainder(start.yaw + yaw_sigma * dyaw, 2.0 * M_PI)};
+  return {start.x + position_sigma * dx, start.y + position_sigma * dy, WrapAngle(start.yaw + yaw_sigma * dyaw)};
 }
 
 namespace {

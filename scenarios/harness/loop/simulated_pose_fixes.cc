@@ -1,4 +1,5 @@
 #include "loop/simulated_pose_fixes.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
@@ -44,7 +45,7 @@ void SimulatedPoseFixes::Capture(double stamp, double x, double y, double yaw) {
   fix.stamp = stamp;
   fix.x = x + parameters_.position_sigma * n_x;
   fix.y = y + parameters_.position_sigma * n_y;
-  fix.yaw = std::remainder(yaw + parameters_.yaw_sigma * n_yaw, 2.0 * M_PI);
+  fix.yaw = WrapAngle(yaw + parameters_.yaw_sigma * n_yaw);
   if (u_outlier < parameters_.outlier_probability) {
     fix.x += outlier_distance * std::cos(outlier_direction);
     fix.y += outlier_distance * std::sin(outlier_direction);

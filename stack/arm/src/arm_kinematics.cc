@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::arm {
 namespace {
@@ -249,7 +250,7 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
     solver.CartToJnt(ToKdl(seed), goal, solution);
     Eigen::VectorXd q = solution.data;
     for (int i = 0; i < joints(); ++i) {
-      if (limits_[static_cast<std::size_t>(i)].continuous) q(i) = -std::remainder(-q(i), 2.0 * M_PI);  // (-pi, pi]
+      if (limits_[static_cast<std::size_t>(i)].continuous) q(i) = -WrapAngle(-q(i));  // (-pi, pi]
     }
     const Eigen::Isometry3d reached = EndEffectorPose(q);
     const double position = (reached.translation() - target.translation()).norm();
@@ -264,7 +265,7 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
     const bool known = std::any_of(result.solutions.begin(), result.solutions.end(), [&](const Eigen::VectorXd& s) {
       Eigen::VectorXd d = s - q;
       for (int i = 0; i < joints(); ++i) {
-        if (limits_[static_cast<std::size_t>(i)].continuous) d(i) = std::remainder(d(i), 2.0 * M_PI);
+        if (limits_[static_cast<std::size_t>(i)].continuous) d(i) = WrapAngle(d(i));
       }
       return d.cwiseAbs().maxCoeff() < options.distinct;
     });

@@ -1,4 +1,5 @@
 #include "trimbot/arm/arm_planner.h"
+#include "trimbot/common/pose2.h"
 
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/SpaceInformation.h>
@@ -24,8 +25,6 @@ namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
 namespace {
-
-double Wrap(double angle) { return std::remainder(angle, 2.0 * M_PI); }
 
 // Joint-space length of a path.
 double Length(const std::vector<Eigen::VectorXd>& path) {
@@ -160,7 +159,7 @@ struct ArmPlanner::Ompl {
     auto* compound = state->as<ob::CompoundState>();
     for (size_t i = 0; i < continuous.size(); ++i) {
       if (continuous[i]) {
-        compound->as<ob::SO2StateSpace::StateType>(i)->value = Wrap(q(static_cast<int>(i)));
+        compound->as<ob::SO2StateSpace::StateType>(i)->value = WrapAngle(q(static_cast<int>(i)));
       } else {
         compound->as<ob::RealVectorStateSpace::StateType>(i)->values[0] = q(static_cast<int>(i));
       }
@@ -307,7 +306,7 @@ void ArmPlanner::SetWaypoints(const Eigen::VectorXd& start, const std::vector<Ei
     Eigen::VectorXd q = raw;
     for (int i = 0; i < q.size(); ++i) {
       if (ompl_->continuous[static_cast<size_t>(i)])
-        q(i) = plan->waypoints.back()(i) + Wrap(raw(i) - plan->waypoints.back()(i));
+        q(i) = plan->waypoints.back()(i) + WrapAngle(raw(i) - plan->waypoints.back()(i));
     }
     plan->waypoints.push_back(q);
   }
@@ -342,7 +341,7 @@ std::optional<Eigen::VectorXd> ArmPlanner::NearestSolution(const Eigen::Isometry
   for (const Eigen::VectorXd& solution : ik.solutions) {
     Eigen::VectorXd q = solution;
     for (int i = 0; i < q.size(); ++i) {
-      if (kinematics_.limits()[static_cast<size_t>(i)].continuous) q(i) = near(i) + Wrap(q(i) - near(i));
+      if (kinematics_.limits()[static_cast<size_t>(i)].continuous) q(i) = near(i) + WrapAngle(q(i) - near(i));
     }
     if (!best || (q - near).cwiseAbs().maxCoeff() < (*best - near).cwiseAbs().maxCoeff()) best = q;
   }

@@ -1,4 +1,5 @@
 #include "trimbot/stack/ekf.h"
+#include "trimbot/common/pose2.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -25,8 +26,9 @@ constexpr double kInitialSpeedSigma = 1.0;      // m/s
 constexpr double kInitialTurnRateSigma = 1.0;   // rad/s
 constexpr double kInitialGyroBiasSigma = 0.02;  // rad/s
 
-double WrapAngle(double angle) {
-  double wrapped = std::remainder(angle, 2.0 * M_PI);  // [-pi, pi]
+// To (-pi, pi].
+double WrapHeading(double angle) {
+  double wrapped = WrapAngle(angle);
   if (wrapped <= -M_PI) wrapped += 2.0 * M_PI;
   return wrapped;
 }
@@ -69,7 +71,7 @@ void PropagateMotion(const StateVector& x, double dt, StateVector* moved, StateM
   *moved = x;
   (*moved)(kX) += chord * c;
   (*moved)(kY) += chord * s;
-  (*moved)(kYaw) = WrapAngle(x(kYaw) + w * dt);
+  (*moved)(kYaw) = WrapHeading(x(kYaw) + w * dt);
   F->setIdentity();
   (*F)(kX, kYaw) = -chord * s;
   (*F)(kY, kYaw) = chord * c;
@@ -134,7 +136,7 @@ void Propagate(const StateVector& x, const StateMatrix& P, double dt, const EkfP
 
 // Measurement model of a pose fix: z = (x + shared_x, y + shared_y, yaw), the yaw innovation wrapped.
 Eigen::Vector3d PoseInnovation(const messages::PoseFix& fix, const StateVector& x) {
-  return {fix.x - x(kX) - x(kSharedX), fix.y - x(kY) - x(kSharedY), WrapAngle(fix.yaw - x(kYaw))};
+  return {fix.x - x(kX) - x(kSharedX), fix.y - x(kY) - x(kSharedY), WrapHeading(fix.yaw - x(kYaw))};
 }
 
 Eigen::Matrix<double, 3, kN> PoseJacobian() {
@@ -177,7 +179,7 @@ bool KalmanUpdate(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Ma
   // K = P H^T S^-1, computed as (S^-1 H P)^T since S and P are symmetric.
   const Eigen::Matrix<double, kN, M> K = llt.solve(H * (*P)).transpose();
   StateVector x_new = *x + K * innovation;
-  x_new(kYaw) = WrapAngle(x_new(kYaw));
+  x_new(kYaw) = WrapHeading(x_new(kYaw));
   const StateMatrix I_KH = StateMatrix::Identity() - K * H;
   StateMatrix P_new = I_KH * (*P) * I_KH.transpose() + K * R * K.transpose();
   P_new = 0.5 * (P_new + P_new.transpose());
@@ -200,7 +202,7 @@ void Ekf::Initialize(double stamp, const Pose2& pose, const Eigen::Matrix3d& pos
   }
   stamp_ = stamp;
   x_.setZero();
-  x_.head<3>() << pose.x, pose.y, WrapAngle(pose.yaw);
+  x_.head<3>() << pose.x, pose.y, WrapHeading(pose.yaw);
   P_.setZero();
   P_.topLeftCorner<3, 3>() = pose_covariance;
   P_(kV, kV) = kInitialSpeedSigma * kInitialSpeedSigma;
@@ -442,7 +444,7 @@ void Ekf::ResetPose(const messages::PoseFix& fix) {
   // the slip stay.
   x_(kX) = fix.x;
   x_(kY) = fix.y;
-  x_(kYaw) = WrapAngle(fix.yaw);
+  x_(kYaw) = WrapHeading(fix.yaw);
   P_.topRows<3>().setZero();
   P_.leftCols<3>().setZero();
   P_.topLeftCorner<3, 3>() = 0.5 * (fix.covariance + fix.covariance.transpose());

@@ -1,4 +1,5 @@
 #include "trimbot/stack/wheel_odometry.h"
+#include "trimbot/common/pose2.h"
 
 #include <cmath>
 
@@ -17,7 +18,7 @@ void WheelOdometry::Update(const messages::WheelTicks& ticks) {
   const double heading = pose_.yaw + 0.5 * turn;
   pose_.x += distance * std::cos(heading);
   pose_.y += distance * std::sin(heading);
-  pose_.yaw = std::remainder(pose_.yaw + turn, 2.0 * M_PI);
+  pose_.yaw = WrapAngle(pose_.yaw + turn);
   const double dt = ticks.stamp - last_->stamp;
   if (dt > 0.0) {
     linear_velocity_ = distance / dt;
@@ -28,7 +29,7 @@ void WheelOdometry::Update(const messages::WheelTicks& ticks) {
 
 void GyroOdometry::AddYawRate(double stamp, double yaw_rate) {
   if (last_gyro_stamp_ >= 0.0 && stamp > last_gyro_stamp_) {
-    pose_.yaw = std::remainder(pose_.yaw + yaw_rate * (stamp - last_gyro_stamp_), 2.0 * M_PI);
+    pose_.yaw = WrapAngle(pose_.yaw + yaw_rate * (stamp - last_gyro_stamp_));
   }
   last_gyro_stamp_ = stamp;
 }
@@ -36,7 +37,7 @@ void GyroOdometry::AddYawRate(double stamp, double yaw_rate) {
 void GyroOdometry::AddWheelTicks(const messages::WheelTicks& ticks) {
   wheels_.Update(ticks);
   const double distance = wheels_.last_distance();
-  const double heading = heading_at_ticks_ + 0.5 * std::remainder(pose_.yaw - heading_at_ticks_, 2.0 * M_PI);
+  const double heading = heading_at_ticks_ + 0.5 * WrapAngle(pose_.yaw - heading_at_ticks_);
   pose_.x += distance * std::cos(heading);
   pose_.y += distance * std::sin(heading);
   heading_at_ticks_ = pose_.yaw;

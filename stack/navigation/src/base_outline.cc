@@ -1,4 +1,5 @@
 #include "trimbot/stack/base_outline.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <array>
@@ -27,8 +28,6 @@ bool SeparatedAlong(const std::array<Eigen::Vector2d, 4>& a, const std::array<Ei
   }
   return a_high < b_low || b_high < a_low;
 }
-
-double WrapAngle(double angle) { return std::remainder(angle, 2.0 * M_PI); }
 
 }  // namespace
 

@@ -1,4 +1,5 @@
 #include "trimbot/stack/bush_servo.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
@@ -108,7 +109,7 @@ messages::BaseVelocityCommand BushServo::Update(double stamp, const Pose2& odome
   if (!tracking()) return {};  // stand and look until the bush is seen
   const Eigen::Vector2d db = DistanceBearing(odometry);
   const double distance_error = db.x() - target_distance_;
-  const double bearing_error = std::remainder(db.y() - parameters_.bearing, 2.0 * M_PI);
+  const double bearing_error = WrapAngle(db.y() - parameters_.bearing);
   const bool arrived = std::abs(distance_error) <= parameters_.distance_tolerance &&
                        std::abs(bearing_error) <= parameters_.bearing_tolerance;
   if (arrived) {

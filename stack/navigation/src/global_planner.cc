@@ -18,6 +18,7 @@
 #include <cmath>
 #include <limits>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/common/random.h"
 
 namespace ob = ompl::base;
@@ -30,8 +31,8 @@ namespace {
 constexpr int kHeadings = 32;  // headings tried where a pose must fit (goals, escapes)
 
 // To [-pi, pi), OMPL's SO(2) bounds.
-double WrapAngle(double angle) {
-  const double wrapped = std::remainder(angle, 2.0 * M_PI);
+double OmplYaw(double angle) {
+  const double wrapped = WrapAngle(angle);
   return wrapped >= M_PI ? wrapped - 2.0 * M_PI : wrapped;
 }
 
@@ -43,7 +44,7 @@ Pose2 ToPose(const ob::State* state) {
 void SetPose(const Pose2& pose, ob::State* state) {
   auto* s = state->as<ob::SE2StateSpace::StateType>();
   s->setXY(pose.x, pose.y);
-  s->setYaw(WrapAngle(pose.yaw));
+  s->setYaw(OmplYaw(pose.yaw));
 }
 
 // The clearance each pose of a plan must keep: min_clearance, except near the start, where the
@@ -182,9 +183,9 @@ namespace {
 
 // The headings a goal may be arrived at: `yaw` if given, else kHeadings round.
 std::vector<double> GoalHeadings(std::optional<double> yaw) {
-  if (yaw) return {WrapAngle(*yaw)};
+  if (yaw) return {OmplYaw(*yaw)};
   std::vector<double> headings;
-  for (int k = 0; k < kHeadings; ++k) headings.push_back(WrapAngle(2.0 * M_PI * k / kHeadings));
+  for (int k = 0; k < kHeadings; ++k) headings.push_back(OmplYaw(2.0 * M_PI * k / kHeadings));
   return headings;
 }
 
@@ -502,10 +503,10 @@ std::vector<Eigen::Vector2d> GlobalPlanner::StandablePositions(const Eigen::Vect
 
 double GlobalPlanner::MotionCost(const Pose2& a, const Pose2& b) const {
   const double length = std::hypot(b.x - a.x, b.y - a.y);
-  if (length < 1e-9) return parameters_.turn_cost * std::abs(WrapAngle(b.yaw - a.yaw));
+  if (length < 1e-9) return parameters_.turn_cost * std::abs(OmplYaw(b.yaw - a.yaw));
   const double heading = std::atan2(b.y - a.y, b.x - a.x);
   double cost =
-      length + parameters_.turn_cost * (std::abs(WrapAngle(heading - a.yaw)) + std::abs(WrapAngle(b.yaw - heading)));
+      length + parameters_.turn_cost * (std::abs(OmplYaw(heading - a.yaw)) + std::abs(OmplYaw(b.yaw - heading)));
   // Clearance below the preferred costs extra, sampled at the middles of 0.2 m pieces. For speed
   // (RRT* costs every candidate edge: this is most of its time) the clearance here is the distance
   // from the outline's centre to the nearest occupied cell less its half width - exact beside a
@@ -724,7 +725,7 @@ PlanResult GlobalPlanner::Plan(const Pose2& start, const Eigen::Vector2d& goal, 
   poses = WithArrivalHeadings(*this, rule, poses);
   if (yaw) {
     // The turn on the spot to the goal's heading where the path ends (the follower makes it).
-    const Pose2 facing{poses.back().x, poses.back().y, WrapAngle(*yaw)};
+    const Pose2 facing{poses.back().x, poses.back().y, OmplYaw(*yaw)};
     if (!MotionClear(*this, rule, poses.back(), facing)) {
       result.message = "no room to turn to the goal's heading where the path ends";
       return result;

@@ -1,4 +1,5 @@
 #include "trimbot/stack/navigator.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <chrono>
@@ -211,8 +212,6 @@ constexpr double kTrailReached = 0.5 * kTrailStep;
 // in the old estimate's frame, no longer says where the robot came from.
 constexpr double kTrailJump = 3.0 * kTrailStep;
 
-double AngleBetween(double to, double from) { return std::remainder(to - from, 2.0 * M_PI); }
-
 }  // namespace
 
 void Navigator::DropTrailIfJumped(const Pose2& estimate) {
@@ -231,7 +230,7 @@ void Navigator::RecordTrail(const Pose2& estimate) {
   if (!trail_.empty()) {
     const Pose2& last = trail_.back();
     if (std::hypot(estimate.x - last.x, estimate.y - last.y) < kTrailStep &&
-        std::abs(AngleBetween(estimate.yaw, last.yaw)) < kTrailTurn) {
+        std::abs(WrapAngle(estimate.yaw - last.yaw)) < kTrailTurn) {
       return;
     }
   }
@@ -274,7 +273,7 @@ messages::BaseVelocityCommand Navigator::BackOff(double stamp, const Pose2& esti
   }
   if (!trail_.empty()) {
     const Eigen::Vector2d away(estimate.x - trail_.back().x, estimate.y - trail_.back().y);
-    const double error = AngleBetween(std::atan2(away.y(), away.x()), estimate.yaw);
+    const double error = WrapAngle(std::atan2(away.y(), away.x()) - estimate.yaw);
     const FollowerParameters& follower = parameters_.follower;
     const bool aligned = std::abs(error) < follower.align_tolerance;
     if (aligned ||

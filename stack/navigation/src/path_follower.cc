@@ -1,4 +1,5 @@
 #include "trimbot/stack/path_follower.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
@@ -77,7 +78,7 @@ FollowerOutput PathFollower::Update(const Pose2& pose) {
   out.distance_to_goal = (goal - position).norm();
   if (at_end_ || out.distance_to_goal < parameters_.goal_tolerance) {
     at_end_ = true;  // a turn on the spot does not leave the end
-    const double turn = final_yaw_ ? std::remainder(*final_yaw_ - pose.yaw, 2.0 * M_PI) : 0.0;
+    const double turn = final_yaw_ ? WrapAngle(*final_yaw_ - pose.yaw) : 0.0;
     if (std::abs(turn) <= parameters_.exact_align_tolerance) {
       out.arrived = true;
       return out;

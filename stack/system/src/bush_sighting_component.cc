@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "mission.h"
+#include "trimbot/common/pose2.h"
 #include "trimbot/perception/bush_estimator.h"
 
 namespace trimbot::stack {
@@ -30,8 +31,7 @@ std::optional<int> BushSightingComponent::PairFacingBush(const StackState& state
   for (std::size_t i = 0; i < rectifiers.size(); ++i) {
     const Eigen::Isometry3d& T = rectifiers[i].T_base_rectified_left();
     const Eigen::Vector2d axis = T.linear().col(2).head<2>(), to_bush = bush - T.translation().head<2>();
-    const double angle =
-        std::abs(std::remainder(std::atan2(to_bush.y(), to_bush.x()) - std::atan2(axis.y(), axis.x()), 2.0 * M_PI));
+    const double angle = std::abs(WrapAngle(std::atan2(to_bush.y(), to_bush.x()) - std::atan2(axis.y(), axis.x())));
     if (angle <= best_angle) {
       best_angle = angle;
       best = static_cast<int>(i);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "trimbot/common/pose2.h"
 #include "trimbot/perception/obstacle_points.h"
 
 namespace trimbot::stack {
@@ -29,7 +30,7 @@ std::vector<int> ObstacleDetectionComponent::PairsAhead(double linear_command) c
   for (std::size_t i = 0; i < rectifiers.size(); ++i) {
     const Eigen::Vector3d axis = rectifiers[i].T_base_rectified_left().linear().col(2);
     const double bearing = std::atan2(axis.y(), axis.x());
-    if (std::abs(std::remainder(bearing - travel, 2.0 * M_PI)) <= parameters_.obstacles.max_bearing) {
+    if (std::abs(WrapAngle(bearing - travel)) <= parameters_.obstacles.max_bearing) {
       pairs.push_back(static_cast<int>(i));
     }
   }

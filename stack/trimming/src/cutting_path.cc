@@ -1,4 +1,5 @@
 #include "trimbot/trimming/cutting_path.h"
+#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,7 +83,7 @@ double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd
   for (int j = 0; j < kinematics.joints(); ++j) {
     const arm::JointLimit& limit = kinematics.limits()[static_cast<std::size_t>(j)];
     double d = to(j) - from(j);
-    if (limit.continuous) d = std::remainder(d, 2.0 * M_PI);
+    if (limit.continuous) d = WrapAngle(d);
     d = std::abs(d);
     const double v = velocity_scale * limit.velocity;
     time = std::max(time, d < v * v / acceleration ? 2.0 * std::sqrt(d / acceleration) : d / v + v / acceleration);

@@ -11,6 +11,9 @@ struct Pose2 {
   double x = 0.0, y = 0.0, yaw = 0.0;
 };
 
+// An angle, or the difference of two headings, brought to [-pi, pi].
+inline double WrapAngle(double angle) { return std::remainder(angle, 2.0 * M_PI); }
+
 // A planar pose as a 3D transform (z = 0), and the planar part of a 3D pose (heading of its x axis).
 inline Eigen::Isometry3d ToIsometry(const Pose2& pose) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
