@@ -1,0 +1,94 @@
+// Trimming's planning times (issue 31): the GTSP solvers on instances of the cutting path's size,
+// and the full cutting path over a ball in front of the robot (blade poses, inverse kinematics of
+// every pose and roll, joint move times, the search and its lazy collision checks). The plan from
+// a database (issue 31's target: <= 100 ms per bush) will be measured beside these.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "trimbot/common/pose2.h"
+#include "trimbot/common/random.h"
+#include "trimbot/robot/collision_model.h"
+#include "trimbot/robot/robot_parameters.h"
+#include "trimbot/trimming/cutting_path.h"
+
+namespace {
+
+using namespace trimbot;
+
+// m clusters of k points each, uniform in the unit square, Euclidean costs.
+trimming::GtspInstance RandomInstance(int m, int k) {
+  Rng rng = MakeRng(7, "trimming_benchmark");
+  std::vector<Eigen::Vector2d> points;
+  trimming::GtspInstance instance;
+  instance.clusters.resize(static_cast<std::size_t>(m));
+  for (int i = 0; i < m * k; ++i) {
+    instance.clusters[static_cast<std::size_t>(i % m)].push_back(i);
+    const double x = UniformUnit(rng);
+    points.emplace_back(x, UniformUnit(rng));
+  }
+  const auto n = static_cast<Eigen::Index>(points.size());
+  instance.cost.resize(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j)
+      instance.cost(i, j) = (points[static_cast<std::size_t>(i)] - points[static_cast<std::size_t>(j)]).norm();
+  }
+  return instance;
+}
+
+void BM_GtspExact12(benchmark::State& state) {
+  const trimming::GtspInstance instance = RandomInstance(12, 5);
+  for (auto _ : state) benchmark::DoNotOptimize(trimming::SolveGtspExact(instance).cost);
+}
+BENCHMARK(BM_GtspExact12)->Unit(benchmark::kMillisecond);
+
+// Clusters x nodes per cluster: the cutting path has about 20-40 reachable poses of 10-25 solutions.
+void BM_GtspSearch(benchmark::State& state) {
+  const trimming::GtspInstance instance =
+      RandomInstance(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  double cost = 0.0, greedy = trimming::SolveGtspNearestNeighbour(instance).cost;
+  for (auto _ : state) cost = trimming::SolveGtspLargeNeighbourhood(instance).cost;
+  state.counters["cost_over_nearest_neighbour"] = cost / greedy;
+}
+BENCHMARK(BM_GtspSearch)->Args({12, 5})->Args({30, 12})->Args({40, 20})->Unit(benchmark::kMillisecond);
+
+void BM_CuttingPathOverABall(benchmark::State& state) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
+  const arm::ArmKinematics kinematics(robot);
+  robot::CollisionModel collision(robot, robot.ArmJointNames());
+  const auto p = robot::RobotParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/robot_parameters.yaml");
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
+  const Eigen::Isometry3d T_cutter_blade =
+      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+  perception::TopiaryShape target;
+  target.centre = {0.95, 0.0, 0.35};
+  target.half = Eigen::Vector3d::Constant(0.3);
+  collision.environment().AddGround("ground", 0.0);
+  collision.environment().AddSphere("target", 0.28, target.centre);
+  const auto valid = [&](const Eigen::VectorXd& q) { return !collision.Check(q).collision; };
+  const auto free_move = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    Eigen::VectorXd d = b - a;
+    for (int j = 0; j < 6; ++j) {
+      if (kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.02)));
+    for (int k = 1; k <= steps; ++k) {
+      if (!valid(a + d * (static_cast<double>(k) / steps))) return false;
+    }
+    return true;
+  };
+  kinematics.PrepareDatabase();
+  const std::vector<Eigen::Isometry3d> poses = trimming::CuttingPoses(target);
+  trimming::CuttingPath path;
+  for (auto _ : state) path = trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, poses, valid, free_move);
+  state.counters["poses"] = static_cast<double>(poses.size());
+  state.counters["reachable"] = path.clusters;
+  state.counters["tour_s"] = path.motion_time;
+  state.counters["nearest_neighbour_s"] = path.nearest_neighbour_time;
+  state.counters["refused_moves"] = path.refused_moves;
+}
+BENCHMARK(BM_CuttingPathOverABall)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
