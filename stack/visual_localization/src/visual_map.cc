@@ -2,8 +2,6 @@
 
 #include <sqlite3.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -15,39 +13,16 @@
 
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
+#include "trimbot/common/sqlite_file.h"
 
 namespace trimbot::visual_localization {
 namespace {
 
-using Database = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
-using Statement = std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)>;
-
-class SqlError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-void Exec(sqlite3* db, const std::string& sql) {
-  char* error = nullptr;
-  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
-    const std::string message = error ? error : "unknown error";
-    sqlite3_free(error);
-    throw SqlError(message + " in: " + sql.substr(0, 60));
-  }
-}
-
-Statement Prepare(sqlite3* db, const std::string& sql) {
-  sqlite3_stmt* statement = nullptr;
-  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &statement, nullptr) != SQLITE_OK) {
-    throw SqlError(std::string(sqlite3_errmsg(db)) + " in: " + sql.substr(0, 60));
-  }
-  return Statement(statement, &sqlite3_finalize);
-}
-
-void Step(sqlite3* db, sqlite3_stmt* statement) {
-  if (sqlite3_step(statement) != SQLITE_DONE) throw SqlError(sqlite3_errmsg(db));
-  sqlite3_reset(statement);
-}
+using sqlite::Exec;
+using sqlite::Prepare;
+using sqlite::SqlError;
+using sqlite::Statement;
+using sqlite::Step;
 
 void BindRow(sqlite3_stmt* statement, int index, const cv::Mat& row) {
   sqlite3_bind_blob(statement, index, row.ptr(), static_cast<int>(row.total() * row.elemSize()), SQLITE_TRANSIENT);
@@ -63,26 +38,19 @@ cv::Mat BlobRow(sqlite3_stmt* statement, int column, int width) {
 
 void WriteSchema(sqlite3* db, const VisualMap& map) {
   Exec(db,
-       "CREATE TABLE meta(key TEXT PRIMARY KEY, value TEXT NOT NULL);"
        "CREATE TABLE keyframes(id INTEGER PRIMARY KEY, stamp REAL, x REAL, y REAL, z REAL,"
        " qw REAL, qx REAL, qy REAL, qz REAL);"
        "CREATE TABLE points(id INTEGER PRIMARY KEY, x REAL, y REAL, z REAL, descriptor BLOB NOT NULL);"
        "CREATE TABLE observations(keyframe INTEGER, camera INTEGER, point INTEGER, u REAL, v REAL);"
        "CREATE TABLE vocabulary(word INTEGER PRIMARY KEY, centroid BLOB NOT NULL);");
-  Statement meta = Prepare(db, "INSERT INTO meta VALUES(?, ?)");
-  for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-           {"format", "trimbot visual map"},
-           {"version", std::to_string(kMapFormatVersion)},
-           {"garden", map.garden},
-           {"rig_signature", map.rig_signature},
-           {"descriptor", ToString(map.descriptor)},
-           {"descriptor_size", std::to_string(map.descriptors.cols)},
-           {"builder", map.builder},
-           {"appearance_version", std::to_string(map.appearance_version)}}) {
-    sqlite3_bind_text(meta.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(meta.get(), 2, value.c_str(), -1, SQLITE_TRANSIENT);
-    Step(db, meta.get());
-  }
+  sqlite::WriteMeta(db, {{"format", "trimbot visual map"},
+                         {"version", std::to_string(kMapFormatVersion)},
+                         {"garden", map.garden},
+                         {"rig_signature", map.rig_signature},
+                         {"descriptor", ToString(map.descriptor)},
+                         {"descriptor_size", std::to_string(map.descriptors.cols)},
+                         {"builder", map.builder},
+                         {"appearance_version", std::to_string(map.appearance_version)}});
 }
 
 void WriteRows(sqlite3* db, const VisualMap& map) {
@@ -119,12 +87,7 @@ void WriteRows(sqlite3* db, const VisualMap& map) {
   }
 }
 
-std::string Meta(sqlite3* db, const std::string& key) {
-  Statement statement = Prepare(db, "SELECT value FROM meta WHERE key = ?");
-  sqlite3_bind_text(statement.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT);
-  if (sqlite3_step(statement.get()) != SQLITE_ROW) throw SqlError("no '" + key + "' in the meta table");
-  return reinterpret_cast<const char*>(sqlite3_column_text(statement.get(), 0));
-}
+using sqlite::Meta;
 
 void ReadRows(sqlite3* db, int descriptor_size, VisualMap* map) {
   Statement keyframes = Prepare(db, "SELECT id, stamp, x, y, z, qw, qx, qy, qz FROM keyframes ORDER BY id");
@@ -167,37 +130,15 @@ void ReadRows(sqlite3* db, int descriptor_size, VisualMap* map) {
 }  // namespace
 
 void VisualMap::Save(const std::string& path) const {
-  const std::string temporary = path + ".tmp" + std::to_string(::getpid());
-  std::filesystem::remove(temporary);
-  sqlite3* raw = nullptr;
-  if (sqlite3_open(temporary.c_str(), &raw) != SQLITE_OK) {
-    sqlite3_close(raw);
-    throw std::runtime_error(path + ": cannot create the map file");
-  }
-  Database db(raw, &sqlite3_close);
-  try {
-    Exec(db.get(), "BEGIN");
-    WriteSchema(db.get(), *this);
-    WriteRows(db.get(), *this);
-    Exec(db.get(), "COMMIT");
-  } catch (const SqlError& e) {
-    db.reset();
-    std::filesystem::remove(temporary);
-    throw std::runtime_error(path + ": writing the map failed: " + e.what());
-  }
-  db.reset();
-  std::filesystem::rename(temporary, path);
+  sqlite::WriteAtomically(path, [this](sqlite3* db) {
+    WriteSchema(db, *this);
+    WriteRows(db, *this);
+  });
 }
 
 VisualMap VisualMap::Load(const std::string& path, const std::string& expected_garden,
                           const std::string& expected_rig_signature, std::optional<Descriptor> expected_descriptor) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "map file not found");
-  sqlite3* raw = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    sqlite3_close(raw);
-    throw InputError(path, "cannot open the map file");
-  }
-  Database db(raw, &sqlite3_close);
+  const sqlite::Database db = sqlite::OpenReadOnly(path, "map file");
   VisualMap map;
   try {
     if (Meta(db.get(), "format") != "trimbot visual map") throw SqlError("not a trimbot visual map");
