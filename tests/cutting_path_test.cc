@@ -8,9 +8,12 @@
 #include <cstdio>
 
 #include "test_support.h"
+#include "trimbot/common/atomic_file.h"
+#include "trimbot/common/input_error.h"
 #include "trimbot/robot/collision_model.h"
 #include "trimbot/robot/robot_parameters.h"
 #include "trimbot/trimming/cutting_path.h"
+#include "trimbot/trimming/plan_database.h"
 
 namespace trimbot::trimming {
 namespace {
@@ -103,6 +106,82 @@ TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   for (std::size_t i = 1; i + 2 < path.configurations.size(); ++i)
     EXPECT_TRUE(f.FreeMove(path.configurations[i], path.configurations[i + 1])) << "move " << i;
   EXPECT_LE(path.motion_time, path.nearest_neighbour_time);
+
+  // The path stored and adapted to a bush 3.6 cm off and 2 cm larger: each blade on the new
+  // surface, from the stored solution's branch, no move refused.
+  perception::TopiaryShape moved = f.target;
+  moved.centre += Eigen::Vector3d(0.03, -0.02, 0.0);
+  moved.half = Eigen::Vector3d::Constant(0.32);
+  f.collision.environment().Clear();
+  f.collision.environment().AddGround("ground", 0.0);
+  f.collision.environment().AddSphere("target", 0.30, moved.centre);
+  const auto adapt_start = std::chrono::steady_clock::now();
+  const CuttingPath adapted = AdaptCuttingPath(
+      f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), moved,
+      [&](const Eigen::VectorXd& q) { return f.Valid(q); },
+      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); }, options);
+  const double adapt_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - adapt_start).count();
+  ASSERT_TRUE(adapted.ok) << adapted.failure;
+  std::printf("adapted to a bush 3.6 cm off, 2 cm larger: %zu of %zu poses, tour %.1f s, in %.0f ms\n",
+              adapted.poses.size(), path.poses.size(), adapted.motion_time, 1000.0 * adapt_seconds);
+  EXPECT_GE(adapted.poses.size() * 2, path.poses.size()) << "most poses carry over (the rest are reported)";
+  for (std::size_t i = 0; i < adapted.blades.size(); ++i) {
+    EXPECT_NEAR(moved.RadialDistance(adapted.blades[i].translation()), 0.0, 1e-6);
+    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(adapted.configurations[i + 1]) * f.T_cutter_blade;
+    EXPECT_LT((blade.translation() - adapted.blades[i].translation()).norm(), 1e-3);
+    EXPECT_GT(blade.linear().col(2).dot(adapted.blades[i].linear().col(2)), std::cos(0.01));
+  }
+  for (std::size_t i = 1; i + 2 < adapted.configurations.size(); ++i)
+    EXPECT_TRUE(f.FreeMove(adapted.configurations[i], adapted.configurations[i + 1])) << "move " << i;
+}
+
+// Stored paths: found by the nearest target of the same shape, written and read back, and refused
+// naming the file when corrupt, of another version or made for another arm.
+TEST(CuttingPathDatabase, RoundTripsFindsTheNearestAndRefusesWhatItCannotUse) {
+  Fixture f;
+  CuttingPathDatabase database;
+  for (double radius : {0.25, 0.3, 0.35}) {
+    StoredCuttingPath stored;
+    stored.target = f.target;
+    stored.target.half = Eigen::Vector3d::Constant(radius);
+    stored.blades = {CuttingPoses(stored.target).front(), CuttingPoses(stored.target).back()};
+    stored.configurations = {f.home, -f.home};
+    stored.motion_time = radius;
+    database.Add(stored);
+  }
+  const std::string signature = ArmSignature(f.kinematics, f.T_cutter_blade);
+  const std::string file = testing::TempDir("cutting_paths") + "/paths.sqlite";
+  database.Save(file, signature);
+  const CuttingPathDatabase loaded = CuttingPathDatabase::Load(file, signature);
+  ASSERT_EQ(loaded.size(), 3);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(loaded.path(i).motion_time, database.path(i).motion_time);
+    EXPECT_EQ(loaded.path(i).configurations[1], database.path(i).configurations[1]);
+    EXPECT_TRUE(loaded.path(i).blades[1].isApprox(database.path(i).blades[1], 1e-12));
+  }
+  perception::TopiaryShape query = f.target;
+  query.half = Eigen::Vector3d::Constant(0.34);
+  double distance = 0.0;
+  const StoredCuttingPath* nearest = loaded.Nearest(query, &distance);
+  ASSERT_NE(nearest, nullptr);
+  EXPECT_EQ(nearest->motion_time, 0.35);
+  EXPECT_NEAR(distance, std::sqrt(3.0) * 0.01, 1e-9);
+  query.vertical_exponent = 6.0;
+  EXPECT_EQ(loaded.Nearest(query), nullptr) << "no cylinder stored";
+
+  const auto refusal = [&](const std::string& expected_signature) {
+    try {
+      CuttingPathDatabase::Load(file, expected_signature);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), file);
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  EXPECT_NE(refusal("another arm").find("another arm or blade"), std::string::npos);
+  WriteFileAtomically(file, "not a database at all, just text");
+  EXPECT_NE(refusal(signature).find("not a valid cutting path database"), std::string::npos) << refusal(signature);
+  EXPECT_NE(refusal(signature + "x").find("cutting path database"), std::string::npos);
 }
 
 TEST(CuttingPath, ABushOutOfReachIsAFailureWithTheReason) {

@@ -22,10 +22,14 @@ Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eige
   return g.normalized();
 }
 
-// A rotation whose z axis is `z` (unit).
-Eigen::Matrix3d FrameWithZ(const Eigen::Vector3d& z) {
-  const Eigen::Vector3d helper = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d x = helper.cross(z).normalized();
+// A rotation whose z axis is `z` (unit) and whose x axis is `x_hint` made perpendicular to it.
+Eigen::Matrix3d FrameWithZ(const Eigen::Vector3d& z, const Eigen::Vector3d& x_hint) {
+  Eigen::Vector3d x = x_hint - x_hint.dot(z) * z;
+  if (x.norm() < 1e-6) {
+    const Eigen::Vector3d helper = std::abs(z.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+    x = helper.cross(z);
+  }
+  x.normalize();
   Eigen::Matrix3d R;
   R.col(0) = x;
   R.col(1) = z.cross(x);
@@ -46,6 +50,16 @@ std::pair<Eigen::Vector3d, double> ReachSphere(const arm::ArmKinematics& kinemat
 
 }  // namespace
 
+Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eigen::Vector3d& direction,
+                              const Eigen::Vector3d& x_hint) {
+  // The surface along the direction: a point 1 m out lies 1 m - radius outside it.
+  const double radius = 1.0 - target.RadialDistance(target.centre + direction);
+  Eigen::Isometry3d blade = Eigen::Isometry3d::Identity();
+  blade.translation() = target.centre + radius * direction;
+  blade.linear() = FrameWithZ(-SurfaceNormal(target, blade.translation()), x_hint);
+  return blade;
+}
+
 std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target, const CuttingPoseOptions& options) {
   // Directions from the centre on a Fibonacci sphere, as many as the surface holds blade spacings
   // (the surface of the ellipsoid through the semi-axes, Knud Thomsen's approximation).
@@ -62,16 +76,11 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
     const double z = 1.0 - 2.0 * (k + 0.5) / count, r = std::sqrt(1.0 - z * z);
     const Eigen::Vector3d d =
         R_yaw * Eigen::Vector3d(r * std::cos(golden_angle * k), r * std::sin(golden_angle * k), z);
-    // The surface along d: a point 1 m out along d lies 1 m - radius outside it.
-    const double radius = 1.0 - target.RadialDistance(target.centre + d);
-    const Eigen::Vector3d point = target.centre + radius * d;
+    const Eigen::Isometry3d blade = BladePoseAt(target, d);
+    const Eigen::Vector3d point = blade.translation();
     if (point.z() < options.min_height) continue;
-    const Eigen::Vector3d normal = SurfaceNormal(target, point);
     const Eigen::Vector3d to_base = (Eigen::Vector3d(0.0, 0.0, point.z()) - point).normalized();
-    if (normal.dot(to_base) < std::cos(options.max_facing_angle)) continue;
-    Eigen::Isometry3d blade = Eigen::Isometry3d::Identity();
-    blade.linear() = FrameWithZ(-normal);
-    blade.translation() = point;
+    if (-blade.linear().col(2).dot(to_base) < std::cos(options.max_facing_angle)) continue;
     poses.push_back(blade);
   }
   return poses;
@@ -100,6 +109,7 @@ struct CuttingInstance {
   std::vector<Eigen::VectorXd> nodes;
   std::vector<int> pose_of_node;
   std::vector<int> cluster_of_node;
+  std::vector<Eigen::Isometry3d> blade_of_node;
 };
 
 CuttingInstance BuildInstance(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
@@ -109,6 +119,7 @@ CuttingInstance BuildInstance(const arm::ArmKinematics& kinematics, const Eigen:
   CuttingInstance c;
   c.nodes = {start};
   c.pose_of_node = {-1};
+  c.blade_of_node = {Eigen::Isometry3d::Identity()};
   c.cluster_of_node = {0};
   c.gtsp.clusters.push_back({0});
   const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
@@ -125,6 +136,7 @@ CuttingInstance BuildInstance(const arm::ArmKinematics& kinematics, const Eigen:
         cluster.push_back(static_cast<int>(c.nodes.size()));
         c.nodes.push_back(q);
         c.pose_of_node.push_back(static_cast<int>(k));
+        c.blade_of_node.push_back(blade);
         c.cluster_of_node.push_back(static_cast<int>(c.gtsp.clusters.size()));
       }
     }
@@ -209,7 +221,9 @@ CuttingPath PlanCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::I
   std::rotate(tour->nodes.begin(), std::find(tour->nodes.begin(), tour->nodes.end(), 0), tour->nodes.end());
   for (int node : tour->nodes) {
     path.configurations.push_back(c.nodes[static_cast<std::size_t>(node)]);
-    if (node != 0) path.poses.push_back(c.pose_of_node[static_cast<std::size_t>(node)]);
+    if (node == 0) continue;
+    path.poses.push_back(c.pose_of_node[static_cast<std::size_t>(node)]);
+    path.blades.push_back(c.blade_of_node[static_cast<std::size_t>(node)]);
   }
   path.configurations.push_back(start);
   path.motion_time = tour->cost;

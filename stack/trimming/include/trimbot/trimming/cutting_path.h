@@ -27,8 +27,13 @@ struct CuttingPoseOptions {
   double min_height = 0.05;       // m above the ground for the blade's centre
 };
 
-// Blade poses (the disc's centre on the target's surface, its z axis into the surface, along the
-// inward normal) in the frame of `target` (base_link), facing the base at the origin.
+// The blade pose on the target's surface along a unit direction from its centre (both in the
+// target's frame, base_link): the disc's centre on the surface, its z axis into it along the inward
+// normal, its x axis `x_hint` made tangent (or any tangent when `x_hint` is zero or normal).
+Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eigen::Vector3d& direction,
+                              const Eigen::Vector3d& x_hint = Eigen::Vector3d::Zero());
+
+// Blade poses over the target's surface, facing the base at the origin.
 std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target,
                                             const CuttingPoseOptions& options = {});
 
@@ -46,6 +51,7 @@ struct CuttingPath {
   std::string failure;                          // when not ok
   std::vector<Eigen::VectorXd> configurations;  // start, then one per reached pose in visiting order, then start
   std::vector<int> poses;                       // the pose of each configuration between start and end
+  std::vector<Eigen::Isometry3d> blades;        // and its blade pose (the roll the arm's solution has)
   std::vector<int> unreachable;                 // poses with no collision-free solution
   double motion_time = 0.0;                     // s: rest-to-rest joint moves along the tour
   double nearest_neighbour_time = 0.0;          // s: the greedy baseline's tour on the same instance
