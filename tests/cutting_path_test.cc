@@ -26,30 +26,20 @@ struct Fixture {
   Eigen::Isometry3d T_cutter_blade;
   perception::TopiaryShape target;
 
-  // A ball of 0.3 m radius in front of the robot. The arm keeps out of it but for the 2 cm a cut may
-  // go deep and still leave the surface within tolerance (the blade's rim tilts on a joint move).
+  CuttingChecks checks;
+
+  // A ball of 0.3 m radius in front of the robot; the arm keeps out of it but for the 2 cm a cut
+  // may go deep and still leave the surface within tolerance.
   Fixture() {
     const auto p = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
     T_cutter_blade = robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
     target.centre = {0.95, 0.0, 0.35};
     target.half = Eigen::Vector3d::Constant(0.3);
-    collision.environment().AddGround("ground", 0.0);
-    collision.environment().AddSphere("target", 0.28, target.centre);
+    checks = MakeCuttingChecks(kinematics, &collision, target);
   }
-  bool Valid(const Eigen::VectorXd& q) const { return !collision.Check(q).collision; }
-  // The straight joint move checked every 0.02 rad (continuous joints the short way round).
-  bool FreeMove(const Eigen::VectorXd& a, const Eigen::VectorXd& b) const {
-    Eigen::VectorXd d = b - a;
-    for (int j = 0; j < 6; ++j) {
-      if (kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = std::remainder(d(j), 2.0 * M_PI);
-    }
-    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.02)));
-    for (int k = 1; k < steps; ++k) {
-      if (!Valid(a + d * (static_cast<double>(k) / steps))) return false;
-    }
-    return Valid(b);
-  }
+  bool Valid(const Eigen::VectorXd& q) const { return checks.valid(q); }
+  bool FreeMove(const Eigen::VectorXd& a, const Eigen::VectorXd& b) const { return checks.free_move(a, b); }
 };
 
 TEST(CuttingPath, BladePosesLieOnTheTargetFacingTheRobot) {
@@ -112,9 +102,7 @@ TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   perception::TopiaryShape moved = f.target;
   moved.centre += Eigen::Vector3d(0.03, -0.02, 0.0);
   moved.half = Eigen::Vector3d::Constant(0.32);
-  f.collision.environment().Clear();
-  f.collision.environment().AddGround("ground", 0.0);
-  f.collision.environment().AddSphere("target", 0.30, moved.centre);
+  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, moved);
   const auto adapt_start = std::chrono::steady_clock::now();
   const CuttingPath adapted = AdaptCuttingPath(
       f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), moved,

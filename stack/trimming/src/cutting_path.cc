@@ -1,11 +1,13 @@
 #include "trimbot/trimming/cutting_path.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <set>
 #include <utility>
+
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::trimming {
 namespace {
@@ -84,6 +86,56 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
     poses.push_back(blade);
   }
   return poses;
+}
+
+CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
+                                const perception::TopiaryShape& target, double tolerance, double step) {
+  // The shrunk target's surface on a polar grid (rings x segments plus the two poles), as a convex
+  // polyhedron (a superellipsoid of exponents >= 2 is convex).
+  constexpr int kRings = 16, kSegments = 32;
+  std::vector<Eigen::Vector3d> vertices;
+  const auto surface = [&](const Eigen::Vector3d& d) {
+    const double radius = 1.0 - target.RadialDistance(target.centre + d);
+    return Eigen::Vector3d(target.centre + std::max(0.0, radius - tolerance) * d);
+  };
+  vertices.push_back(surface(Eigen::Vector3d::UnitZ()));
+  for (int r = 1; r < kRings; ++r) {
+    const double polar = M_PI * r / kRings;
+    for (int s = 0; s < kSegments; ++s) {
+      const double azimuth = 2.0 * M_PI * s / kSegments;
+      vertices.push_back(surface(
+          Eigen::Vector3d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar))));
+    }
+  }
+  vertices.push_back(surface(-Eigen::Vector3d::UnitZ()));
+  const int bottom = static_cast<int>(vertices.size()) - 1;
+  const auto at = [](int ring, int segment) { return 1 + (ring - 1) * kSegments + (segment % kSegments); };
+  std::vector<std::array<int, 3>> triangles;
+  for (int s = 0; s < kSegments; ++s) {
+    triangles.push_back({0, at(1, s), at(1, s + 1)});
+    for (int r = 1; r + 1 < kRings; ++r) {
+      triangles.push_back({at(r, s), at(r + 1, s), at(r + 1, s + 1)});
+      triangles.push_back({at(r, s), at(r + 1, s + 1), at(r, s + 1)});
+    }
+    triangles.push_back({at(kRings - 1, s), bottom, at(kRings - 1, s + 1)});
+  }
+  collision->environment().Clear();
+  collision->environment().AddGround("ground", 0.0);
+  collision->environment().AddConvex("target", vertices, triangles);
+  CuttingChecks checks;
+  checks.valid = [collision](const Eigen::VectorXd& q) { return !collision->Check(q).collision; };
+  checks.free_move = [&kinematics, valid = checks.valid, step](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    Eigen::VectorXd d = b - a;
+    for (int j = 0; j < kinematics.joints(); ++j) {
+      if (kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / step)));
+    for (int k = 1; k <= steps; ++k) {
+      if (!valid(a + d * (static_cast<double>(k) / steps))) return false;
+    }
+    return true;
+  };
+  return checks;
 }
 
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,

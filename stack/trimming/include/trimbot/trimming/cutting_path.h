@@ -15,6 +15,7 @@
 
 #include "trimbot/arm/arm_kinematics.h"
 #include "trimbot/perception/topiary_fit.h"
+#include "trimbot/robot/collision_model.h"
 #include "trimbot/trimming/gtsp.h"
 
 namespace trimbot::trimming {
@@ -63,6 +64,17 @@ struct CuttingPath {
 // profile, the slowest joint sets it; continuous joints the short way round).
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration);
+
+// The collision checks of a cutting path on the arm's collision model, whose environment becomes
+// the ground and the target shrunk by `tolerance` as a solid (convex) polyhedron: the blade may go
+// that deep, and the surface it leaves stays within tolerance of the target. A move is free when
+// its configurations `step` apart (rad, continuous joints the short way round) are.
+struct CuttingChecks {
+  std::function<bool(const Eigen::VectorXd&)> valid;
+  std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)> free_move;
+};
+CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
+                                const perception::TopiaryShape& target, double tolerance = 0.02, double step = 0.02);
 
 // `valid(q)`: the configuration is free; `free_move(a, b)`: the straight joint move is free.
 // `T_cutter_blade`: the blade's disc in the cutter frame (from the URDF).
