@@ -1,5 +1,5 @@
 // The trimbot CLI's drive: a short run writes its outputs and a summary that says what happened;
-// a broken plan is an input error naming the file.
+// a broken plan is an input error naming the file. Trim precompute stores what it solved.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -7,8 +7,11 @@
 #include <fstream>
 
 #include "runners/drive.h"
+#include "runners/trim_precompute.h"
 #include "test_support.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/trimming/plan_database.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -83,6 +86,43 @@ TEST(DriveCommand, UnknownGardenIsAnInputError) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("unknown garden 'versailles'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TrimPrecompute, StoresTheSolvedPathsForThisArmAndRefusesAnUnknownShape) {
+  TrimPrecomputeOptions options;
+  options.out = testing::TempDir("trim_precompute") + "/paths.sqlite";
+  options.shapes = {"ball", "box"};
+  options.sizes = {0.6};
+  options.distances = {0.95};
+  options.spacing = 0.15;
+  options.rolls = 2;
+  ASSERT_EQ(RunTrimPrecompute(options, {TRIMBOT_SOURCE_DIR}), 0);
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  const arm::ArmKinematics kinematics(robot);
+  const Eigen::Isometry3d T_cutter_blade =
+      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+  const trimming::CuttingPathDatabase database =
+      trimming::CuttingPathDatabase::Load(options.out, trimming::ArmSignature(kinematics, T_cutter_blade));
+  ASSERT_EQ(database.size(), 2);
+  for (int i = 0; i < 2; ++i) {
+    const trimming::StoredCuttingPath& path = database.path(i);
+    EXPECT_NEAR(path.target.centre.x(), 0.95, 1e-12);
+    EXPECT_NEAR(path.target.half.x(), 0.3, 1e-12);
+    ASSERT_FALSE(path.blades.empty());
+    // Each stored solution puts the blade on its stored pose.
+    for (std::size_t k = 0; k < path.blades.size(); ++k) {
+      const Eigen::Isometry3d blade = kinematics.EndEffectorPose(path.configurations[k]) * T_cutter_blade;
+      EXPECT_LT((blade.translation() - path.blades[k].translation()).norm(), 1e-3);
+    }
+  }
+  EXPECT_EQ(database.path(1).target.horizontal_exponent, 6.0) << "the box";
+  options.shapes = {"cone"};
+  try {
+    RunTrimPrecompute(options, {TRIMBOT_SOURCE_DIR});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown shape 'cone'"), std::string::npos) << e.what();
   }
 }
 

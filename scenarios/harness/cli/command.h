@@ -51,5 +51,6 @@ void AddTuningCommands(Commands& commands);  // sweep, tune, ablate
 void AddMapCommands(Commands& commands);     // map build | ensure | bench | retrieval-eval
 void AddFusionCommand(Commands& commands);
 void AddStereoCommand(Commands& commands);
+void AddTrimCommands(Commands& commands);  // trim precompute
 
 }  // namespace trimbot::scenarios

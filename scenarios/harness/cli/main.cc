@@ -22,5 +22,6 @@ int main(int argc, char** argv) {
   AddMapCommands(commands);
   AddFusionCommand(commands);
   AddStereoCommand(commands);
+  AddTrimCommands(commands);
   return commands.ParseAndRun(argc, argv);
 }

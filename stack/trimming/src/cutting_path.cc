@@ -213,38 +213,42 @@ CuttingInstance BuildInstance(const arm::ArmKinematics& kinematics, const Eigen:
 }
 
 // Lazy edge checking: solve, check the tour's moves; where one is refused, check every move
-// between the two poses' solutions (their neighbours collide alike), forbid the refused ones, and
-// solve again. The moves to and from the start are not checked: the arm planner plans them round
-// obstacles when they are executed.
-std::optional<GtspTour> SolveWithFreeMoves(
-    CuttingInstance* c, const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
-    const CuttingPathOptions& options, CuttingPath* path) {
+// between the two poses' solutions (their neighbours collide alike). A refused move becomes one
+// the arm planner plans round obstacles, costed as the way through the start (always open to the
+// planner: it plans the moves from and back to the start too), and the tour is solved again until
+// every move it makes has been checked. Returns the moves to plan.
+GtspTour SolveWithCheckedMoves(CuttingInstance* c,
+                               const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
+                               const CuttingPathOptions& options, CuttingPath* path,
+                               std::set<std::pair<int, int>>* planned) {
+  const Eigen::MatrixXd direct = c->gtsp.cost;
   std::set<std::pair<int, int>> checked_clusters;
   const auto check_clusters = [&](int a, int b) {
     const auto key =
         std::minmax(c->cluster_of_node[static_cast<std::size_t>(a)], c->cluster_of_node[static_cast<std::size_t>(b)]);
-    if (!checked_clusters.insert(key).second) return;
+    if (!checked_clusters.insert(key).second) return false;
     for (int u : c->gtsp.clusters[static_cast<std::size_t>(key.first)]) {
       for (int v : c->gtsp.clusters[static_cast<std::size_t>(key.second)]) {
         if (free_move(c->nodes[static_cast<std::size_t>(u)], c->nodes[static_cast<std::size_t>(v)])) continue;
-        c->gtsp.cost(u, v) = c->gtsp.cost(v, u) = std::numeric_limits<double>::infinity();
+        c->gtsp.cost(u, v) = direct(u, 0) + direct(0, v);
+        c->gtsp.cost(v, u) = direct(v, 0) + direct(0, u);
+        planned->insert(std::minmax(u, v));
         ++path->refused_moves;
       }
     }
+    return true;
   };
+  GtspTour tour;
   for (int round = 0; round < options.max_lazy_rounds; ++round) {
-    const GtspTour tour = SolveGtspLargeNeighbourhood(c->gtsp, options.search);
-    if (!tour.Feasible()) break;
-    bool all_free = true;
+    tour = SolveGtspLargeNeighbourhood(c->gtsp, options.search);
+    bool newly_checked = false;
     for (std::size_t i = 0; i < tour.nodes.size(); ++i) {
       const int a = tour.nodes[i], b = tour.nodes[(i + 1) % tour.nodes.size()];
-      if (a == 0 || b == 0) continue;
-      check_clusters(a, b);
-      all_free = all_free && std::isfinite(c->gtsp.cost(a, b));
+      if (a != 0 && b != 0 && check_clusters(a, b) && planned->count(std::minmax(a, b))) newly_checked = true;
     }
-    if (all_free) return tour;
+    if (!newly_checked) break;
   }
-  return std::nullopt;
+  return tour;
 }
 
 }  // namespace
@@ -263,22 +267,22 @@ CuttingPath PlanCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::I
                    " m from its shoulder)";
     return path;
   }
-  std::optional<GtspTour> tour = SolveWithFreeMoves(&c, free_move, options, &path);
-  if (!tour) {
-    path.failure = "no tour of free moves through the " + std::to_string(path.clusters) + " reachable poses (" +
-                   std::to_string(path.refused_moves) + " moves refused)";
-    return path;
-  }
+  std::set<std::pair<int, int>> planned;
+  GtspTour tour = SolveWithCheckedMoves(&c, free_move, options, &path, &planned);
   // The tour from the start round and back to it.
-  std::rotate(tour->nodes.begin(), std::find(tour->nodes.begin(), tour->nodes.end(), 0), tour->nodes.end());
-  for (int node : tour->nodes) {
+  std::rotate(tour.nodes.begin(), std::find(tour.nodes.begin(), tour.nodes.end(), 0), tour.nodes.end());
+  tour.nodes.push_back(0);
+  for (std::size_t i = 0; i < tour.nodes.size(); ++i) {
+    const int node = tour.nodes[i];
     path.configurations.push_back(c.nodes[static_cast<std::size_t>(node)]);
+    if (i > 0)
+      path.planned.push_back(node == 0 || tour.nodes[i - 1] == 0 ||
+                             planned.count(std::minmax(tour.nodes[i - 1], node)) > 0);
     if (node == 0) continue;
     path.poses.push_back(c.pose_of_node[static_cast<std::size_t>(node)]);
     path.blades.push_back(c.blade_of_node[static_cast<std::size_t>(node)]);
   }
-  path.configurations.push_back(start);
-  path.motion_time = tour->cost;
+  path.motion_time = tour.cost;
   path.nearest_neighbour_time = SolveGtspNearestNeighbour(c.gtsp).cost;
   path.ok = true;
   return path;

@@ -205,11 +205,13 @@ CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::
       path.unreachable.push_back(static_cast<int>(k));
       continue;
     }
+    path.planned.push_back(first);
     path.configurations.push_back(*q);
     path.poses.push_back(static_cast<int>(k));
     path.blades.push_back(blade);
   }
   path.configurations.push_back(start);
+  path.planned.push_back(true);
   path.clusters = static_cast<int>(path.poses.size());
   if (path.poses.empty()) {
     path.failure = "none of the stored path's " + std::to_string(stored.blades.size()) + " poses fits this target";

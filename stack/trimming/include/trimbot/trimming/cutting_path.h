@@ -4,10 +4,10 @@
 // collision-free inverse-kinematics solutions of each pose as one GTSP cluster (the blade spins,
 // so its roll about its axis is free: several rolls per pose), the edge cost the time of a
 // rest-to-rest joint move between two solutions, and a tour through one solution of every pose.
-// Moves between blade poses are straight joint moves: those the collision check refuses are
-// forbidden and the tour solved again (lazy edge checking: only the edges a tour uses are checked).
-// The moves from the start to the first pose and back from the last are costed as straight moves
-// but not checked: the arm planner plans them round obstacles when they are executed.
+// Moves between blade poses are straight joint moves where the collision check lets them be;
+// where it refuses one, the arm planner plans it round obstacles, costed as the way through the
+// start, and the tour is solved again (lazy edge checking: only the moves a tour makes, and their
+// poses' other solutions, are checked). The moves from the start and back are the planner's too.
 #include <Eigen/Geometry>
 #include <functional>
 #include <string>
@@ -53,11 +53,13 @@ struct CuttingPath {
   std::vector<Eigen::VectorXd> configurations;  // start, then one per reached pose in visiting order, then start
   std::vector<int> poses;                       // the pose of each configuration between start and end
   std::vector<Eigen::Isometry3d> blades;        // and its blade pose (the roll the arm's solution has)
-  std::vector<int> unreachable;                 // poses with no collision-free solution
-  double motion_time = 0.0;                     // s: rest-to-rest joint moves along the tour
-  double nearest_neighbour_time = 0.0;          // s: the greedy baseline's tour on the same instance
-  int clusters = 0, nodes = 0;                  // of the GTSP
-  int refused_moves = 0;                        // edges the collision check forbade
+  std::vector<bool> planned;            // per move (configuration i to i + 1): for the arm planner to plan round
+                                        // obstacles (from and back to the start, and where a straight move is refused)
+  std::vector<int> unreachable;         // poses with no collision-free solution
+  double motion_time = 0.0;             // s: rest-to-rest joint moves along the tour
+  double nearest_neighbour_time = 0.0;  // s: the greedy baseline's tour on the same instance
+  int clusters = 0, nodes = 0;          // of the GTSP
+  int refused_moves = 0;                // straight moves the collision check refused
 };
 
 // Time of a joint move from rest to rest along a straight joint-space line (trapezoidal speed
