@@ -52,24 +52,35 @@ void BM_GtspSearch(benchmark::State& state) {
 }
 BENCHMARK(BM_GtspSearch)->Args({12, 5})->Args({30, 12})->Args({40, 20})->Unit(benchmark::kMillisecond);
 
-void BM_CuttingPathOverABall(benchmark::State& state) {
-  const robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
-  const arm::ArmKinematics kinematics(robot);
-  robot::CollisionModel collision(robot, robot.ArmJointNames());
-  const auto p = robot::RobotParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/robot_parameters.yaml");
-  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
-  const Eigen::Isometry3d T_cutter_blade =
+// The robot's arm with its collision model, and a 0.6 m ball 0.95 m ahead.
+struct BallInFront {
+  robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
+  arm::ArmKinematics kinematics{robot};
+  robot::CollisionModel collision{robot, robot.ArmJointNames()};
+  Eigen::VectorXd home;
+  Eigen::Isometry3d T_cutter_blade =
       robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
   perception::TopiaryShape target;
-  target.centre = {0.95, 0.0, 0.35};
-  target.half = Eigen::Vector3d::Constant(0.3);
-  const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(kinematics, &collision, target);
-  kinematics.PrepareDatabase();
-  const std::vector<Eigen::Isometry3d> poses = trimming::CuttingPoses(target);
+
+  BallInFront() {
+    const auto p = robot::RobotParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/robot_parameters.yaml");
+    home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
+    target.centre = {0.95, 0.0, 0.35};
+    target.half = Eigen::Vector3d::Constant(0.3);
+    kinematics.PrepareDatabase();
+  }
+  trimming::CuttingPath PlanInFull() {
+    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(kinematics, &collision, target);
+    return trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target), checks.valid,
+                                     checks.free_move);
+  }
+};
+
+void BM_CuttingPathOverABall(benchmark::State& state) {
+  BallInFront ball;
   trimming::CuttingPath path;
-  for (auto _ : state)
-    path = trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, poses, checks.valid, checks.free_move);
-  state.counters["poses"] = static_cast<double>(poses.size());
+  for (auto _ : state) path = ball.PlanInFull();
+  state.counters["poses"] = static_cast<double>(trimming::CuttingPoses(ball.target).size());
   state.counters["reachable"] = path.clusters;
   state.counters["tour_s"] = path.motion_time;
   state.counters["nearest_neighbour_s"] = path.nearest_neighbour_time;
@@ -80,34 +91,22 @@ BENCHMARK(BM_CuttingPathOverABall)->Unit(benchmark::kSecond)->Iterations(1);
 // The plan from a stored path (issue 31's target: <= 100 ms per bush): the path over the ball,
 // planned once, adapted to balls 2-5 cm off and up to 3 cm larger or smaller.
 void BM_AdaptStoredPath(benchmark::State& state) {
-  const robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
-  const arm::ArmKinematics kinematics(robot);
-  robot::CollisionModel collision(robot, robot.ArmJointNames());
-  const auto p = robot::RobotParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/robot_parameters.yaml");
-  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
-  const Eigen::Isometry3d T_cutter_blade =
-      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
-  perception::TopiaryShape target;
-  target.centre = {0.95, 0.0, 0.35};
-  target.half = Eigen::Vector3d::Constant(0.3);
-  trimming::CuttingChecks checks = trimming::MakeCuttingChecks(kinematics, &collision, target);
-  const std::vector<Eigen::Isometry3d> poses = trimming::CuttingPoses(target);
-  const trimming::CuttingPath full =
-      trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, poses, checks.valid, checks.free_move);
-  const trimming::StoredCuttingPath stored = trimming::ToStored(full, target);
+  BallInFront ball;
+  const trimming::CuttingPath full = ball.PlanInFull();
+  const trimming::StoredCuttingPath stored = trimming::ToStored(full, ball.target);
   Rng rng = MakeRng(11, "adapt_benchmark");
   double kept = 0.0, time_ratio = 0.0;
   int adaptations = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    perception::TopiaryShape moved = target;
+    perception::TopiaryShape moved = ball.target;
     const double angle = 2.0 * M_PI * UniformUnit(rng), offset = 0.02 + 0.03 * UniformUnit(rng);
     moved.centre += offset * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
     moved.half = Eigen::Vector3d::Constant(0.27 + 0.06 * UniformUnit(rng));
-    checks = trimming::MakeCuttingChecks(kinematics, &collision, moved);
+    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(ball.kinematics, &ball.collision, moved);
     state.ResumeTiming();
-    const trimming::CuttingPath adapted =
-        trimming::AdaptCuttingPath(kinematics, T_cutter_blade, home, stored, moved, checks.valid, checks.free_move);
+    const trimming::CuttingPath adapted = trimming::AdaptCuttingPath(ball.kinematics, ball.T_cutter_blade, ball.home,
+                                                                     stored, moved, checks.valid, checks.free_move);
     kept += static_cast<double>(adapted.poses.size()) / static_cast<double>(full.poses.size());
     time_ratio += adapted.ok ? adapted.motion_time / full.motion_time : 0.0;
     ++adaptations;

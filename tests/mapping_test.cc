@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <regex>
 
@@ -240,30 +241,33 @@ TEST(MapBuild, AMapFromARecordedDriveIsWithinItsStatedErrorsAndReportsItsGaps) {
     EXPECT_TRUE(std::regex_search(gap.get<std::string>(), std::regex("00001[5-9]/cam3.png"))) << gap;
   }
 
-  const std::string imu = testing::ReadText(recording + "/sensors/imu.csv");
-  std::string broken = imu;
-  broken.insert(broken.find('\n', broken.find('\n') + 1) + 1, "0.01,1,2\n");  // line 3
-  WriteFileAtomically(recording + "/sensors/imu.csv", broken);
-  try {
-    scenarios::RunMapBuild(options);
-    ADD_FAILURE() << "a malformed IMU log was accepted";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), recording + "/sensors/imu.csv");
-    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
-  }
+  // A malformed sensor log is refused naming the file and the line; the file is restored after.
+  const auto expect_refused = [&](const std::string& file, const std::function<void(std::string*)>& spoil,
+                                  const std::string& message) {
+    const std::string path = recording + "/sensors/" + file, good = testing::ReadText(path);
+    std::string broken = good;
+    spoil(&broken);
+    WriteFileAtomically(path, broken);
+    try {
+      scenarios::RunMapBuild(options);
+      ADD_FAILURE() << file << " was accepted with " << message;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+    WriteFileAtomically(path, good);
+  };
+  expect_refused(
+      "imu.csv", [](std::string* text) { text->insert(text->find('\n', text->find('\n') + 1) + 1, "0.01,1,2\n"); },
+      "line 3");
   // An encoder count that is not a whole number.
-  WriteFileAtomically(recording + "/sensors/imu.csv", imu);
-  std::string ticks = testing::ReadText(recording + "/sensors/wheel_ticks.csv");
-  const std::size_t line2 = ticks.find('\n') + 1;
-  ticks.replace(line2, ticks.find('\n', line2) - line2, "0.0,1.5,2");
-  WriteFileAtomically(recording + "/sensors/wheel_ticks.csv", ticks);
-  try {
-    scenarios::RunMapBuild(options);
-    ADD_FAILURE() << "a fractional tick count was accepted";
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), recording + "/sensors/wheel_ticks.csv");
-    EXPECT_NE(std::string(e.what()).find("line 2: tick count 1.5"), std::string::npos) << e.what();
-  }
+  expect_refused(
+      "wheel_ticks.csv",
+      [](std::string* text) {
+        const std::size_t line2 = text->find('\n') + 1;
+        text->replace(line2, text->find('\n', line2) - line2, "0.0,1.5,2");
+      },
+      "line 2: tick count 1.5");
 }
 
 TEST(MapBuild, AShortDriveGivesAConsistentMap) {

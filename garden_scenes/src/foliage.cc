@@ -70,6 +70,17 @@ double FirstCrossing(const Eigen::Vector3d& d, double limit, const Eigen::Vector
   return first <= std::min(hi, s_out) && falls(t0 + t1 * first) ? first : kNoCut;
 }
 
+// The unit direction at the centre of cell (r, s) of a grid of rings x segments (polar x azimuth).
+Eigen::Vector3d CellDirection(int r, int s, int rings, int segments) {
+  const double polar = M_PI * (r + 0.5) / rings, azimuth = 2.0 * M_PI * (s + 0.5) / segments;
+  return {std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar)};
+}
+
+// The solid angle of a cell of ring r.
+double CellSolidAngle(int r, int rings, int segments) {
+  return std::sin(M_PI * (r + 0.5) / rings) * (M_PI / rings) * (2.0 * M_PI / segments);
+}
+
 }  // namespace
 
 double Superellipsoid::Radius(const Eigen::Vector3d& d) const {
@@ -96,13 +107,9 @@ double Superellipsoid::Volume() const {
   constexpr int kRings = 180, kSegments = 360;
   double volume = 0.0;
   for (int r = 0; r < kRings; ++r) {
-    const double polar = M_PI * (r + 0.5) / kRings;
-    for (int s = 0; s < kSegments; ++s) {
-      const double azimuth = 2.0 * M_PI * (s + 0.5) / kSegments;
-      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
-                              std::cos(polar));
-      volume += std::pow(Radius(d), 3) / 3.0 * std::sin(polar) * (M_PI / kRings) * (2.0 * M_PI / kSegments);
-    }
+    for (int s = 0; s < kSegments; ++s)
+      volume +=
+          std::pow(Radius(CellDirection(r, s, kRings, kSegments)), 3) / 3.0 * CellSolidAngle(r, kRings, kSegments);
   }
   return volume;
 }
@@ -142,15 +149,12 @@ Foliage Foliage::Grown(const GardenObject& object, std::uint64_t appearance_seed
   foliage.T_map_centre_.matrix() = T;
   foliage.T_map_centre_.translate(Eigen::Vector3d(0.0, 0.0, foliage.target_.half.z()));
   for (int r = 0; r < rings; ++r) {
-    const double polar = M_PI * (r + 0.5) / rings;
     for (int s = 0; s < segments; ++s) {
-      const double azimuth = 2.0 * M_PI * (s + 0.5) / segments;
-      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
-                              std::cos(polar));
+      const Eigen::Vector3d d = CellDirection(r, s, rings, segments);
       // Never below the shape's bottom (it sits on the ground or its stem).
       const double floor = d.z() < 0.0 ? foliage.target_.half.z() / -d.z() : kNoCut;
       foliage.direction_.push_back(d);
-      foliage.solid_angle_.push_back(std::sin(polar) * (M_PI / rings) * (2.0 * M_PI / segments));
+      foliage.solid_angle_.push_back(CellSolidAngle(r, rings, segments));
       foliage.radius_.push_back(std::min(grown.SurfacePoint(d).dot(d), floor));
       foliage.target_radius_.push_back(std::min(foliage.target_.Radius(d), floor));
       foliage.floor_radius_.push_back(floor);
