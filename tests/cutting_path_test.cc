@@ -3,6 +3,7 @@
 // a tour of free joint moves through one of each.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,9 @@
 #include "test_support.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
+#include "trimbot/common/pose2.h"
+#include "trimbot/common/random.h"
+#include "trimbot/garden/foliage.h"
 #include "trimbot/robot/collision_model.h"
 #include "trimbot/robot/robot_parameters.h"
 #include "trimbot/trimming/cutting_path.h"
@@ -191,6 +195,81 @@ TEST(CuttingPath, ABushOutOfReachIsAFailureWithTheReason) {
       [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); });
   EXPECT_FALSE(path.ok);
   EXPECT_NE(path.failure.find("no blade pose"), std::string::npos) << path.failure;
+}
+
+// The blocks together, without the simulator: a ball grown 5 cm past its target, its target fitted
+// to the leaves seen from the robot's side, the cutting path planned on the fit, and the blade
+// swept along the path's straight moves through the foliage (the planned moves, to and from the
+// start and round refused moves, are taken with the blade clear). The share of the surface within
+// 2 cm of the target must rise, over the side the arm reaches and over the whole bush.
+TEST(CuttingPath, SweepingThePlannedPathTrimsTheSideTheArmReaches) {
+  Fixture f;
+  garden::GardenObject bush;
+  bush.id = 1;
+  bush.object_class = garden::ObjectClass::kTopiary;
+  bush.shape = garden::Shape::kEllipsoid;
+  bush.size = {0.6, 0.6, 0.6};
+  bush.position = {0.95, 0.0};  // the robot stands at the map's origin: base_link is the map frame
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.05 / (0.15 * 1.6));
+  const garden::CutQuality before = foliage.Measure();
+  // What stereo sees from the base: the leaves facing it.
+  std::vector<Eigen::Vector3d> leaves;
+  Rng rng = MakeRng(4, "leaves");
+  const std::vector<Eigen::Vector3d> surface = foliage.SurfacePoints();
+  for (int i = 0; i < foliage.columns(); i += 3) {
+    if (foliage.direction(i).x() < -0.2)
+      leaves.push_back(surface[static_cast<std::size_t>(i)] + 0.005 * StandardNormalVector<Eigen::Vector3d>(rng));
+  }
+  perception::TopiaryShape guess = f.target;
+  guess.centre += Eigen::Vector3d(0.05, 0.03, -0.02);
+  const auto fit = perception::FitTopiary(leaves, guess, perception::AxesTied::kAll);
+  ASSERT_TRUE(fit);
+  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, fit->shape);
+  CuttingPathOptions options;
+  options.rolls = 4;
+  const CuttingPath path = PlanCuttingPath(f.kinematics, f.T_cutter_blade, f.home, CuttingPoses(fit->shape),
+                                           f.checks.valid, f.checks.free_move, options);
+  ASSERT_TRUE(path.ok) << path.failure;
+  const auto blade_at = [&](const Eigen::VectorXd& q) {
+    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(q) * f.T_cutter_blade;
+    garden::BladeDisc disc;
+    disc.centre = blade.translation();
+    disc.axis = blade.linear().col(2);
+    disc.radius = 0.05;  // the URDF's blade
+    return disc;
+  };
+  for (std::size_t i = 0; i < path.planned.size(); ++i) {
+    if (path.planned[i]) continue;
+    Eigen::VectorXd d = path.configurations[i + 1] - path.configurations[i];
+    for (int j = 0; j < 6; ++j) {
+      if (f.kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
+    for (int k = 0; k < steps; ++k)
+      foliage.Cut(blade_at(path.configurations[i] + d * (static_cast<double>(k) / steps)),
+                  blade_at(path.configurations[i] + d * (static_cast<double>(k + 1) / steps)));
+  }
+  const garden::CutQuality after = foliage.Measure();
+  // The side facing the robot: columns pointing towards it.
+  const auto near_side_share = [&](const garden::Foliage& state) {
+    int within = 0, count = 0;
+    for (int i = 0; i < state.columns(); ++i) {
+      if (state.direction(i).x() > -0.5) continue;
+      ++count;
+      within += std::abs(state.radius(i) - state.target_radius(i)) <= 0.02 ? 1 : 0;
+    }
+    return static_cast<double>(within) / count;
+  };
+  const garden::Foliage grown = garden::Foliage::Grown(bush, 4, 0.05 / (0.15 * 1.6));
+  std::printf(
+      "kinematic trim of a 0.6 m ball grown 5 cm: fit %.1f mm off; %d poses, %zu straight moves swept; within "
+      "2 cm %.1f %% -> %.1f %% (near side %.1f %% -> %.1f %%); over-cut %.2f %% of the target\n",
+      1000.0 * (fit->shape.centre - foliage.pose().translation()).norm(), path.clusters,
+      static_cast<std::size_t>(std::count(path.planned.begin(), path.planned.end(), false)),
+      100.0 * before.surface_within_tolerance, 100.0 * after.surface_within_tolerance, 100.0 * near_side_share(grown),
+      100.0 * near_side_share(foliage), 100.0 * after.overcut_volume / after.target_volume);
+  EXPECT_GT(after.surface_within_tolerance, before.surface_within_tolerance);
+  EXPECT_GT(near_side_share(foliage), near_side_share(grown) + 0.2);
 }
 
 }  // namespace
