@@ -197,79 +197,95 @@ TEST(CuttingPath, ABushOutOfReachIsAFailureWithTheReason) {
   EXPECT_NE(path.failure.find("no blade pose"), std::string::npos) << path.failure;
 }
 
-// The blocks together, without the simulator: a ball grown 5 cm past its target, its target fitted
-// to the leaves seen from the robot's side, the cutting path planned on the fit, and the blade
-// swept along the path's straight moves through the foliage (the planned moves, to and from the
-// start and round refused moves, are taken with the blade clear). The share of the surface within
-// 2 cm of the target must rise, over the side the arm reaches and over the whole bush.
-TEST(CuttingPath, SweepingThePlannedPathTrimsTheSideTheArmReaches) {
+// The blocks together, without the simulator: a ball grown 5 cm past its target, trimmed from four
+// standoffs round it (the base 0.95 m from its centre, facing it). At each, the target is fitted to
+// the leaves facing the robot, the cutting path planned on the fit, and the blade swept along the
+// path's straight moves through the foliage (the planned moves - to and from the start, round
+// refused moves - are taken with the blade clear). The share of the surface within 2 cm of the
+// target must rise on the side each standoff faces and by 10 points over the whole bush; the
+// over-cut is reported (issue 31's targets, >= 90 % and < 1 %, are for the closed loop).
+TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
   Fixture f;
   garden::GardenObject bush;
   bush.id = 1;
   bush.object_class = garden::ObjectClass::kTopiary;
   bush.shape = garden::Shape::kEllipsoid;
   bush.size = {0.6, 0.6, 0.6};
-  bush.position = {0.95, 0.0};  // the robot stands at the map's origin: base_link is the map frame
-  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.05 / (0.15 * 1.6));
+  bush.position = {2.0, 1.0};
+  const double growth = 0.05 / (0.15 * 1.6);  // shoots up to 5 cm past the target
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, growth);
   const garden::CutQuality before = foliage.Measure();
-  // What stereo sees from the base: the leaves facing it.
-  std::vector<Eigen::Vector3d> leaves;
-  Rng rng = MakeRng(4, "leaves");
-  const std::vector<Eigen::Vector3d> surface = foliage.SurfacePoints();
-  for (int i = 0; i < foliage.columns(); i += 3) {
-    if (foliage.direction(i).x() < -0.2)
-      leaves.push_back(surface[static_cast<std::size_t>(i)] + 0.005 * StandardNormalVector<Eigen::Vector3d>(rng));
-  }
-  perception::TopiaryShape guess = f.target;
-  guess.centre += Eigen::Vector3d(0.05, 0.03, -0.02);
-  const auto fit = perception::FitTopiary(leaves, guess, perception::AxesTied::kAll);
-  ASSERT_TRUE(fit);
-  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, fit->shape);
-  CuttingPathOptions options;
-  options.rolls = 4;
-  const CuttingPath path = PlanCuttingPath(f.kinematics, f.T_cutter_blade, f.home, CuttingPoses(fit->shape),
-                                           f.checks.valid, f.checks.free_move, options);
-  ASSERT_TRUE(path.ok) << path.failure;
-  const auto blade_at = [&](const Eigen::VectorXd& q) {
-    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(q) * f.T_cutter_blade;
-    garden::BladeDisc disc;
-    disc.centre = blade.translation();
-    disc.axis = blade.linear().col(2);
-    disc.radius = 0.05;  // the URDF's blade
-    return disc;
-  };
-  for (std::size_t i = 0; i < path.planned.size(); ++i) {
-    if (path.planned[i]) continue;
-    Eigen::VectorXd d = path.configurations[i + 1] - path.configurations[i];
-    for (int j = 0; j < 6; ++j) {
-      if (f.kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
-    }
-    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
-    for (int k = 0; k < steps; ++k)
-      foliage.Cut(blade_at(path.configurations[i] + d * (static_cast<double>(k) / steps)),
-                  blade_at(path.configurations[i] + d * (static_cast<double>(k + 1) / steps)));
-  }
-  const garden::CutQuality after = foliage.Measure();
-  // The side facing the robot: columns pointing towards it.
-  const auto near_side_share = [&](const garden::Foliage& state) {
+  // The share within 2 cm among the columns facing direction `towards` (map frame).
+  const auto facing_share = [](const garden::Foliage& state, const Eigen::Vector3d& towards) {
     int within = 0, count = 0;
     for (int i = 0; i < state.columns(); ++i) {
-      if (state.direction(i).x() > -0.5) continue;
+      if (state.direction(i).dot(towards) < 0.5) continue;
       ++count;
       within += std::abs(state.radius(i) - state.target_radius(i)) <= 0.02 ? 1 : 0;
     }
     return static_cast<double>(within) / count;
   };
-  const garden::Foliage grown = garden::Foliage::Grown(bush, 4, 0.05 / (0.15 * 1.6));
+  Rng rng = MakeRng(4, "leaves");
+  CuttingPathOptions options;
+  options.rolls = 4;
+  for (int k = 0; k < 4; ++k) {
+    const double bearing = M_PI / 2 * k;  // of the base from the bush
+    const Eigen::Vector3d towards(std::cos(bearing), std::sin(bearing), 0.0);
+    Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+    T_map_base.translation() = Eigen::Vector3d(bush.position.x(), bush.position.y(), 0.0) + 0.95 * towards;
+    T_map_base.linear() = Eigen::AngleAxisd(bearing + M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    // What stereo sees from there: the leaves facing the base, in base_link.
+    std::vector<Eigen::Vector3d> leaves;
+    const std::vector<Eigen::Vector3d> surface = foliage.SurfacePoints();
+    for (int i = 0; i < foliage.columns(); i += 3) {
+      if (foliage.direction(i).dot(towards) > 0.2)
+        leaves.push_back(T_map_base.inverse() * surface[static_cast<std::size_t>(i)] +
+                         0.005 * StandardNormalVector<Eigen::Vector3d>(rng));
+    }
+    perception::TopiaryShape guess = f.target;  // the plan's ball, where it should be from here
+    guess.centre += Eigen::Vector3d(0.05, 0.03, -0.02);
+    const auto fit = perception::FitTopiary(leaves, guess, perception::AxesTied::kAll);
+    ASSERT_TRUE(fit);
+    f.checks = MakeCuttingChecks(f.kinematics, &f.collision, fit->shape);
+    CuttingPoseOptions pose_options;
+    pose_options.spacing = 0.1;
+    const CuttingPath path =
+        PlanCuttingPath(f.kinematics, f.T_cutter_blade, f.home, CuttingPoses(fit->shape, pose_options), f.checks.valid,
+                        f.checks.free_move, options);
+    ASSERT_TRUE(path.ok) << path.failure;
+    const auto blade_at = [&](const Eigen::VectorXd& q) {
+      const Eigen::Isometry3d blade = T_map_base * f.kinematics.EndEffectorPose(q) * f.T_cutter_blade;
+      garden::BladeDisc disc;
+      disc.centre = blade.translation();
+      disc.axis = blade.linear().col(2);
+      disc.radius = 0.05;  // the URDF's blade
+      return disc;
+    };
+    const double side_before = facing_share(foliage, towards);
+    for (std::size_t i = 0; i < path.planned.size(); ++i) {
+      if (path.planned[i]) continue;
+      Eigen::VectorXd d = path.configurations[i + 1] - path.configurations[i];
+      for (int j = 0; j < 6; ++j) {
+        if (f.kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
+      }
+      const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
+      for (int s = 0; s < steps; ++s)
+        foliage.Cut(blade_at(path.configurations[i] + d * (static_cast<double>(s) / steps)),
+                    blade_at(path.configurations[i] + d * (static_cast<double>(s + 1) / steps)));
+    }
+    std::printf("standoff %d: fit %.1f mm off, %d poses, the side it faces %.1f %% -> %.1f %% within 2 cm\n", k,
+                1000.0 * ((T_map_base * fit->shape.centre) - foliage.pose().translation()).norm(), path.clusters,
+                100.0 * side_before, 100.0 * facing_share(foliage, towards));
+    // Later standoffs find their side partly trimmed already from the ones before.
+    EXPECT_GT(facing_share(foliage, towards), side_before) << "standoff " << k;
+  }
+  const garden::CutQuality after = foliage.Measure();
   std::printf(
-      "kinematic trim of a 0.6 m ball grown 5 cm: fit %.1f mm off; %d poses, %zu straight moves swept; within "
-      "2 cm %.1f %% -> %.1f %% (near side %.1f %% -> %.1f %%); over-cut %.2f %% of the target\n",
-      1000.0 * (fit->shape.centre - foliage.pose().translation()).norm(), path.clusters,
-      static_cast<std::size_t>(std::count(path.planned.begin(), path.planned.end(), false)),
-      100.0 * before.surface_within_tolerance, 100.0 * after.surface_within_tolerance, 100.0 * near_side_share(grown),
-      100.0 * near_side_share(foliage), 100.0 * after.overcut_volume / after.target_volume);
-  EXPECT_GT(after.surface_within_tolerance, before.surface_within_tolerance);
-  EXPECT_GT(near_side_share(foliage), near_side_share(grown) + 0.2);
+      "kinematic trim of a 0.6 m ball grown 5 cm from 4 standoffs: within 2 cm %.1f %% -> %.1f %% of the "
+      "surface; over-cut %.2f %% of the target volume\n",
+      100.0 * before.surface_within_tolerance, 100.0 * after.surface_within_tolerance,
+      100.0 * after.overcut_volume / after.target_volume);
+  EXPECT_GT(after.surface_within_tolerance, before.surface_within_tolerance + 0.1);
 }
 
 }  // namespace
