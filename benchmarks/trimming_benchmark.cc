@@ -58,8 +58,7 @@ struct BallInFront {
   arm::ArmKinematics kinematics{robot};
   robot::CollisionModel collision{robot, robot.ArmJointNames()};
   Eigen::VectorXd home;
-  Eigen::Isometry3d T_cutter_blade =
-      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+  Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
   perception::TopiaryShape target;
 
   BallInFront() {

@@ -100,8 +100,7 @@ TEST(TrimPrecompute, StoresTheSolvedPathsForThisArmAndRefusesAnUnknownShape) {
   ASSERT_EQ(RunTrimPrecompute(options, {TRIMBOT_SOURCE_DIR}), 0);
   const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
   const arm::ArmKinematics kinematics(robot);
-  const Eigen::Isometry3d T_cutter_blade =
-      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+  const Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
   const trimming::CuttingPathDatabase database =
       trimming::CuttingPathDatabase::Load(options.out, trimming::ArmSignature(kinematics, T_cutter_blade));
   ASSERT_EQ(database.size(), 2);

@@ -11,7 +11,6 @@
 #include "test_support.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
-#include "trimbot/common/pose2.h"
 #include "trimbot/common/random.h"
 #include "trimbot/garden/foliage.h"
 #include "trimbot/robot/collision_model.h"
@@ -37,7 +36,7 @@ struct Fixture {
   Fixture() {
     const auto p = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
-    T_cutter_blade = robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+    T_cutter_blade = robot.BladeInCutter();
     target.centre = {0.95, 0.0, 0.35};
     target.half = Eigen::Vector3d::Constant(0.3);
     checks = MakeCuttingChecks(kinematics, &collision, target);
@@ -237,10 +236,7 @@ void SweepBlade(const Fixture& f, const CuttingPath& path, const Eigen::Isometry
   };
   for (std::size_t i = 0; i < path.planned.size(); ++i) {
     if (path.planned[i]) continue;
-    Eigen::VectorXd d = path.configurations[i + 1] - path.configurations[i];
-    for (int j = 0; j < 6; ++j) {
-      if (f.kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
-    }
+    const Eigen::VectorXd d = f.kinematics.JointDifference(path.configurations[i], path.configurations[i + 1]);
     const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
     for (int s = 0; s < steps; ++s)
       foliage->Cut(blade_at(path.configurations[i] + d * (static_cast<double>(s) / steps)),

@@ -195,6 +195,11 @@ void Foliage::Cut(const BladeDisc& from, const BladeDisc& to) {
   }
 }
 
+double Foliage::NormalCosine(std::size_t i) const {
+  const Eigen::Vector3d& d = direction_[i];
+  return std::max(0.1, std::abs(d.dot(target_.Normal(target_radius_[i] * d))));
+}
+
 CutQuality Foliage::Measure(double tolerance) const {
   CutQuality q;
   double area = 0.0, within = 0.0;
@@ -206,8 +211,7 @@ CutQuality Foliage::Measure(double tolerance) const {
     q.max_overgrowth = std::max(q.max_overgrowth, r - t);
     // The distance along the target's normal, and the surface element the column's solid angle
     // spans at its radius.
-    const Eigen::Vector3d& d = direction_[i];
-    const double cosine = std::max(0.1, std::abs(d.dot(target_.Normal(t * d))));
+    const double cosine = NormalCosine(i);
     const double element = w * r * r / cosine;
     area += element;
     if (std::abs((r - t) * cosine) <= tolerance) within += element;
@@ -230,11 +234,9 @@ void Foliage::WritePly(const std::string& path) const {
       << "property float distance\nend_header\n";
   const std::vector<Eigen::Vector3d> points = SurfacePoints();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3d& d = direction_[i];
-    const double cosine = std::max(0.1, std::abs(d.dot(target_.Normal(target_radius_[i] * d))));
     const float values[4] = {static_cast<float>(points[i].x()), static_cast<float>(points[i].y()),
                              static_cast<float>(points[i].z()),
-                             static_cast<float>((radius_[i] - target_radius_[i]) * cosine)};
+                             static_cast<float>((radius_[i] - target_radius_[i]) * NormalCosine(i))};
     char bytes[sizeof(values)];
     std::memcpy(bytes, values, sizeof(values));  // little-endian hosts only (x86-64, arm64)
     out.write(bytes, sizeof(bytes));

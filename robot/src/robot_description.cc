@@ -131,6 +131,11 @@ Eigen::Isometry3d RobotDescription::FramePose(const std::string& link,
   return pose;
 }
 
+Eigen::Isometry3d RobotDescription::BladeInCutter() const {
+  return FramePose(RobotFrames::kEndEffector).inverse() *
+         FramePose(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
+}
+
 std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() const {
   Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d high = -low;

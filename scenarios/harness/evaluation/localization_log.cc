@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "evaluation/pose_errors.h"
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -51,7 +52,7 @@ void LocalizationLog::AddFix(const stack::AppliedFix& applied, const TruePose* t
   row.sigma_m = LargestPositionSigma(covariance);
   if (truth == nullptr) return;
   const Eigen::Vector3d error(applied.fix.x - truth->x, applied.fix.y - truth->y,
-                              AngleDifference(applied.fix.yaw, truth->yaw));
+                              WrapAngle(applied.fix.yaw - truth->yaw));
   row.error_m = error.head<2>().norm();
   row.nees = PlanarNees(error, covariance);
 }

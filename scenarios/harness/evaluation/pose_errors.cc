@@ -1,5 +1,4 @@
 #include "evaluation/pose_errors.h"
-#include "trimbot/common/pose2.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -18,8 +17,6 @@ double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isom
 double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth) {
   return (estimate.translation() - truth.translation()).norm();
 }
-
-double AngleDifference(double a, double b) { return WrapAngle(a - b); }
 
 double PlanarNees(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance) {
   return error.dot(covariance.ldlt().solve(error));

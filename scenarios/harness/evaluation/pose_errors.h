@@ -7,8 +7,6 @@ namespace trimbot::scenarios {
 // Geodesic rotation error in degrees and translation error in metres of `estimate` against `truth`.
 double RotationErrorDegrees(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
 double TranslationError(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth);
-// Planar heading difference a - b wrapped to [-pi, pi].
-double AngleDifference(double a, double b);
 // Normalized estimation error squared of a planar error (x, y, yaw) against the covariance the
 // estimate stated: 3 on average when the covariance is what the error is (not finite for a
 // singular covariance).

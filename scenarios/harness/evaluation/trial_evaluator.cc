@@ -10,6 +10,7 @@
 #include "evaluation/pose_errors.h"
 #include "evaluation/tum_trajectory.h"
 #include "trimbot/common/atomic_file.h"
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::scenarios {
 namespace {
@@ -18,7 +19,7 @@ constexpr double kEvaluationPeriod = 0.1;  // s: estimate errors and trajectorie
 
 void AddError(EstimateErrors& errors, double truth_x, double truth_y, double truth_yaw, const Pose2& pose) {
   errors.position_m.push_back(std::hypot(pose.x - truth_x, pose.y - truth_y));
-  errors.heading_deg.push_back(std::abs(AngleDifference(pose.yaw, truth_yaw)) * 180.0 / M_PI);
+  errors.heading_deg.push_back(std::abs(WrapAngle(pose.yaw - truth_yaw)) * 180.0 / M_PI);
 }
 
 std::string Tum(double t, const Pose2& pose) { return TumLine(t, ToIsometry(pose)); }
@@ -66,7 +67,7 @@ void TrialEvaluator::ObserveBushSightings(const StepView& step) {
     frame.found = sighting.found;
     if (sighting.found) {
       frame.distance_error_m = sighting.distance - truth.x();
-      frame.bearing_error_deg = AngleDifference(sighting.bearing, truth.y()) * 180.0 / M_PI;
+      frame.bearing_error_deg = WrapAngle(sighting.bearing - truth.y()) * 180.0 / M_PI;
     }
     bush_frames_.push_back(frame);
   }
@@ -78,9 +79,9 @@ void TrialEvaluator::JudgeBushGoal(const stack::NavigationEvent& event, const Pl
   if (!status) return;  // the stack never reported approaching it: not reached
   const Eigen::Vector2d actual = TrueBushDistanceBearing(truth, event.goal);
   goal->bush_distance_error_m = actual.x() - status->target_distance;
-  goal->bush_bearing_error_deg = AngleDifference(actual.y(), status->target_bearing) * 180.0 / M_PI;
+  goal->bush_bearing_error_deg = WrapAngle(actual.y() - status->target_bearing) * 180.0 / M_PI;
   goal->bush_estimate_distance_error_m = status->distance - actual.x();
-  goal->bush_estimate_bearing_error_deg = AngleDifference(status->bearing, actual.y()) * 180.0 / M_PI;
+  goal->bush_estimate_bearing_error_deg = WrapAngle(status->bearing - actual.y()) * 180.0 / M_PI;
   goal->final_error_m = std::abs(goal->bush_distance_error_m);
   goal->reached = std::abs(goal->bush_distance_error_m) <= criteria_.bush_distance &&
                   std::abs(goal->bush_bearing_error_deg) <= criteria_.bush_bearing * 180.0 / M_PI;
@@ -130,7 +131,7 @@ void TrialEvaluator::Observe(const StepView& step) {
     if (at == nullptr) continue;
     AddError(fixes_, at->x, at->y, at->yaw, {fix.x, fix.y, fix.yaw});
     // Is the fix's stated covariance what its error is? (NEES: 3 on average when it is.)
-    const Eigen::Vector3d error(fix.x - at->x, fix.y - at->y, AngleDifference(fix.yaw, at->yaw));
+    const Eigen::Vector3d error(fix.x - at->x, fix.y - at->y, WrapAngle(fix.yaw - at->yaw));
     const double nees = PlanarNees(error, fix.covariance);
     if (std::isfinite(nees)) fixes_.nees.push_back(nees);
   }
@@ -205,7 +206,7 @@ void TrialEvaluator::Sample(const StepView& step, const PlanarPose& truth) {
   const Pose2& odometry = step.telemetry->odometry;
   sample_times_.push_back(step.time);
   AddError(ekf_, truth.x, truth.y, truth.yaw, estimate);
-  const Eigen::Vector3d error(estimate.x - truth.x, estimate.y - truth.y, AngleDifference(estimate.yaw, truth.yaw));
+  const Eigen::Vector3d error(estimate.x - truth.x, estimate.y - truth.y, WrapAngle(estimate.yaw - truth.yaw));
   const double nees = PlanarNees(error, step.telemetry->estimate.covariance);
   if (std::isfinite(nees)) ekf_.nees.push_back(nees);  // a covariance of zero (an exact start) has none
   AddError(odometry_, truth.x, truth.y, truth.yaw, odometry);
@@ -242,7 +243,7 @@ void TrialEvaluator::ObserveEvents(const StepView& step, const PlanarPose& truth
       goal.final_error_m = std::hypot(truth.x - goal.used_x, truth.y - goal.used_y);
       goal.reached = goal.final_error_m <= criteria_.tolerance;
       if (goal.yaw_deg) {
-        const double error = AngleDifference(truth.yaw, *goal.yaw_deg * M_PI / 180.0);
+        const double error = WrapAngle(truth.yaw - *goal.yaw_deg * M_PI / 180.0);
         goal.final_heading_error_deg = error * 180.0 / M_PI;
         goal.reached = goal.reached && std::abs(error) <= criteria_.yaw_tolerance;
       }

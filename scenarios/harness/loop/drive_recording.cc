@@ -86,12 +86,11 @@ DriveRecording DriveRecording::Load(const std::string& dir) {
   const std::string ticks_path = dir + "/sensors/wheel_ticks.csv";
   ReadCsv(ticks_path, 3, [&](const std::vector<double>& f, int line) {
     if (!recording.wheel_ticks_.empty()) CheckOrder(ticks_path, recording.wheel_ticks_.back().stamp, f[0], line);
-    for (int wheel : {1, 2}) {
+    for (const double count : {f[1], f[2]}) {
       // Encoder counts are whole numbers (and within the 53 bits a double holds exactly).
-      if (f[static_cast<std::size_t>(wheel)] != std::floor(f[static_cast<std::size_t>(wheel)]) ||
-          std::abs(f[static_cast<std::size_t>(wheel)]) > 9007199254740992.0)
-        throw InputError(ticks_path, "line " + std::to_string(line) + ": tick count " +
-                                         std::to_string(f[static_cast<std::size_t>(wheel)]) + " is not a whole number");
+      if (count != std::floor(count) || std::abs(count) > 9007199254740992.0)
+        throw InputError(ticks_path, "line " + std::to_string(line) + ": tick count " + std::to_string(count) +
+                                         " is not a whole number");
     }
     recording.wheel_ticks_.push_back({f[0], static_cast<std::int64_t>(f[1]), static_cast<std::int64_t>(f[2])});
   });

@@ -1,8 +1,9 @@
 #include "loop/simulated_pose_fixes.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
+
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::scenarios {
 

@@ -24,6 +24,7 @@
 #include "reports/localization_timing.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/overrides.h"
+#include "trimbot/common/pose2.h"
 #include "trimbot/common/random.h"
 #include "trimbot/robot/robot_files.h"
 #include "trimbot/stack/robot_stack.h"
@@ -172,7 +173,7 @@ struct BenchTally {
     }
     ++fixes;
     const Pose2 fix = ToPose2(result.T_map_base);
-    const Eigen::Vector3d error3(fix.x - truth.x, fix.y - truth.y, AngleDifference(fix.yaw, truth.yaw));
+    const Eigen::Vector3d error3(fix.x - truth.x, fix.y - truth.y, WrapAngle(fix.yaw - truth.yaw));
     const double error = error3.head<2>().norm();
     position_errors.push_back(error);
     heading_errors.push_back(std::abs(error3.z()) * 180.0 / M_PI);

@@ -47,8 +47,7 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
   robot::CollisionModel collision(robot, robot.ArmJointNames());
   const auto parameters = robot::RobotParameters::Load(files.robot_parameters);
   const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(parameters.arm_home_position.data(), 6);
-  const Eigen::Isometry3d T_cutter_blade =
-      robot.FramePose("arm_end_effector").inverse() * robot.FramePose("cutter_blade_link");
+  const Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
   trimming::CuttingPoseOptions pose_options;
   pose_options.spacing = options.spacing;
   trimming::CuttingPathOptions path_options;

@@ -194,6 +194,16 @@ bool ArmKinematics::WithinLimits(const Eigen::VectorXd& q) const {
   return true;
 }
 
+Eigen::VectorXd ArmKinematics::JointDifference(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
+  CheckSize(from);
+  CheckSize(to);
+  Eigen::VectorXd d = to - from;
+  for (int i = 0; i < joints(); ++i) {
+    if (limits_[static_cast<std::size_t>(i)].continuous) d(i) = WrapAngle(d(i));
+  }
+  return d;
+}
+
 const SeedDatabase& ArmKinematics::Database(int size) const {
   std::call_once(chain_->database_built, [&] {
     static constexpr int kPrimes[6] = {17, 19, 23, 29, 31, 37};  // not the starts' primes
@@ -263,11 +273,7 @@ IkResult ArmKinematics::InverseKinematics(const Eigen::Isometry3d& target, const
       continue;
     }
     const bool known = std::any_of(result.solutions.begin(), result.solutions.end(), [&](const Eigen::VectorXd& s) {
-      Eigen::VectorXd d = s - q;
-      for (int i = 0; i < joints(); ++i) {
-        if (limits_[static_cast<std::size_t>(i)].continuous) d(i) = WrapAngle(d(i));
-      }
-      return d.cwiseAbs().maxCoeff() < options.distinct;
+      return JointDifference(q, s).cwiseAbs().maxCoeff() < options.distinct;
     });
     if (!known) result.solutions.push_back(q);
   }

@@ -1,5 +1,4 @@
 #include "trimbot/arm/arm_planner.h"
-#include "trimbot/common/pose2.h"
 
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/SpaceInformation.h>
@@ -18,6 +17,8 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::arm {
 

@@ -1,5 +1,4 @@
 #include "trimbot/stack/ekf.h"
-#include "trimbot/common/pose2.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>

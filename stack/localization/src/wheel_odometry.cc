@@ -1,5 +1,4 @@
 #include "trimbot/stack/wheel_odometry.h"
-#include "trimbot/common/pose2.h"
 
 #include <cmath>
 

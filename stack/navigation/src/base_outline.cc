@@ -1,5 +1,4 @@
 #include "trimbot/stack/base_outline.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <array>

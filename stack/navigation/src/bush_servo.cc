@@ -1,8 +1,9 @@
 #include "trimbot/stack/bush_servo.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>
+
+#include "trimbot/common/pose2.h"
 
 namespace trimbot::stack {
 namespace {

@@ -1,5 +1,4 @@
 #include "trimbot/stack/navigator.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <chrono>

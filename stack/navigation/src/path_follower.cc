@@ -1,5 +1,4 @@
 #include "trimbot/stack/path_follower.h"
-#include "trimbot/common/pose2.h"
 
 #include <algorithm>
 #include <cmath>

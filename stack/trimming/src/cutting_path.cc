@@ -7,8 +7,6 @@
 #include <set>
 #include <utility>
 
-#include "trimbot/common/pose2.h"
-
 namespace trimbot::trimming {
 namespace {
 
@@ -54,10 +52,8 @@ std::pair<Eigen::Vector3d, double> ReachSphere(const arm::ArmKinematics& kinemat
 
 Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eigen::Vector3d& direction,
                               const Eigen::Vector3d& x_hint) {
-  // The surface along the direction: a point 1 m out lies 1 m - radius outside it.
-  const double radius = 1.0 - target.RadialDistance(target.centre + direction);
   Eigen::Isometry3d blade = Eigen::Isometry3d::Identity();
-  blade.translation() = target.centre + radius * direction;
+  blade.translation() = target.centre + target.Radius(direction) * direction;
   blade.linear() = FrameWithZ(-SurfaceNormal(target, blade.translation()), x_hint);
   return blade;
 }
@@ -95,8 +91,7 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::Col
   constexpr int kRings = 16, kSegments = 32;
   std::vector<Eigen::Vector3d> vertices;
   const auto surface = [&](const Eigen::Vector3d& d) {
-    const double radius = 1.0 - target.RadialDistance(target.centre + d);
-    return Eigen::Vector3d(target.centre + std::max(0.0, radius - tolerance) * d);
+    return Eigen::Vector3d(target.centre + std::max(0.0, target.Radius(d) - tolerance) * d);
   };
   vertices.push_back(surface(Eigen::Vector3d::UnitZ()));
   for (int r = 1; r < kRings; ++r) {
@@ -125,10 +120,7 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::Col
   CuttingChecks checks;
   checks.valid = [collision](const Eigen::VectorXd& q) { return !collision->Check(q).collision; };
   checks.free_move = [&kinematics, valid = checks.valid, step](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-    Eigen::VectorXd d = b - a;
-    for (int j = 0; j < kinematics.joints(); ++j) {
-      if (kinematics.limits()[static_cast<std::size_t>(j)].continuous) d(j) = WrapAngle(d(j));
-    }
+    const Eigen::VectorXd d = kinematics.JointDifference(a, b);
     const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / step)));
     for (int k = 1; k <= steps; ++k) {
       if (!valid(a + d * (static_cast<double>(k) / steps))) return false;
@@ -140,13 +132,11 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::Col
 
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration) {
+  const Eigen::VectorXd difference = kinematics.JointDifference(from, to);
   double time = 0.0;
   for (int j = 0; j < kinematics.joints(); ++j) {
-    const arm::JointLimit& limit = kinematics.limits()[static_cast<std::size_t>(j)];
-    double d = to(j) - from(j);
-    if (limit.continuous) d = WrapAngle(d);
-    d = std::abs(d);
-    const double v = velocity_scale * limit.velocity;
+    const double d = std::abs(difference(j));
+    const double v = velocity_scale * kinematics.limits()[static_cast<std::size_t>(j)].velocity;
     time = std::max(time, d < v * v / acceleration ? 2.0 * std::sqrt(d / acceleration) : d / v + v / acceleration);
   }
   return time;

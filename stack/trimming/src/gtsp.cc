@@ -145,9 +145,8 @@ void InsertClusters(const Eigen::MatrixXd& w, const GtspInstance& instance, std:
 
 // Reverses the segment of the tour that saves most (2-opt; for asymmetric costs the segment's own
 // edges change direction, counted from prefix sums of both directions), until none saves.
-bool ReverseSegments(const Eigen::MatrixXd& w, std::vector<int>* nodes) {
+void ReverseSegments(const Eigen::MatrixXd& w, std::vector<int>* nodes) {
   const std::size_t m = nodes->size();
-  bool changed = false;
   for (bool improved = m > 3; improved;) {
     improved = false;
     std::vector<double> forward(m, 0.0), backward(m, 0.0);  // along the tour up to position k
@@ -173,10 +172,9 @@ bool ReverseSegments(const Eigen::MatrixXd& w, std::vector<int>* nodes) {
     if (best_j > best_i) {
       std::reverse(nodes->begin() + static_cast<std::ptrdiff_t>(best_i),
                    nodes->begin() + static_cast<std::ptrdiff_t>(best_j) + 1);
-      improved = changed = true;
+      improved = true;
     }
   }
-  return changed;
 }
 
 // Takes every cluster out in turn and puts it back where it costs least, until no move helps.

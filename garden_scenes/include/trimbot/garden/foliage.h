@@ -93,6 +93,9 @@ class Foliage {
  private:
   void CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& axis,
                      double radius);
+  // |cos| of the angle between column i and the target's normal where it crosses the target (at
+  // least 0.1): the radial excess times it is the distance along the normal.
+  double NormalCosine(std::size_t i) const;
 
   Superellipsoid target_;
   Eigen::Isometry3d T_map_centre_ = Eigen::Isometry3d::Identity();

@@ -38,6 +38,9 @@ class RobotDescription {
 
   // Pose of a link in base_link with every joint at the given position (default zero).
   Eigen::Isometry3d FramePose(const std::string& link, const std::map<std::string, double>& joint_positions = {}) const;
+  // The cutter blade's frame (the child of cutter_blade_joint: the disc about its z axis) in the
+  // cutter frame (arm_end_effector), the blade at zero turn.
+  Eigen::Isometry3d BladeInCutter() const;
   // Pose of a child link in its parent link for the joint at position q.
   static Eigen::Isometry3d JointTransform(const urdf::Joint& joint, double q);
 

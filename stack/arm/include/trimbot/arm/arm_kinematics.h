@@ -68,6 +68,8 @@ class ArmKinematics {
   double Manipulability(const Eigen::VectorXd& q) const;
   // `q` within the limits (continuous joints always are); std::invalid_argument for a wrong size.
   bool WithinLimits(const Eigen::VectorXd& q) const;
+  // `to` - `from` per joint, the continuous joints the short way round (rad).
+  Eigen::VectorXd JointDifference(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
   // Every distinct joint solution that puts the cutter frame at `target` (base_link).
   IkResult InverseKinematics(const Eigen::Isometry3d& target, const IkOptions& options = {}) const;
   // Builds the database of pre-computed poses now (else the first InverseKinematics does).

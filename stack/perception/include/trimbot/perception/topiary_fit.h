@@ -24,6 +24,9 @@ struct TopiaryShape {
 
   // Signed distance from the surface along the ray from the centre through `point` (outside > 0).
   double RadialDistance(const Eigen::Vector3d& point) const;
+  // Distance from the centre to the surface along a unit direction (a point 1 m out along it lies
+  // 1 m - radius outside).
+  double Radius(const Eigen::Vector3d& direction) const { return 1.0 - RadialDistance(centre + direction); }
 };
 
 // Which semi-axes are tied: a ball's three, a round cylinder's or ellipsoid's two horizontal ones.
