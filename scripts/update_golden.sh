@@ -4,7 +4,7 @@
 # with the change that caused them, saying why they changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-for scenario in navigation/smoke bush_approach/smoke arm/smoke; do
+for scenario in navigation/smoke bush_approach/smoke arm/smoke trim/smoke; do
   out=$(mktemp -d)
   build/bin/trimbot run "scenarios/$scenario.yaml" --out "$out" > /dev/null
   cp "$out/summary.json" "tests/golden/${scenario//\//_}_summary.json"

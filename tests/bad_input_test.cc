@@ -46,6 +46,8 @@ start: {x: 0.0, y: 0.0, yaw_deg: 10.0}
 goals:
   - {x: 4.0, y: 0.0}
   - {approach_bush: 1}
+  - {trim_bush: 2}
+cutting_path_database: paths.sqlite
 goal_tolerance: 0.3
 bush_tolerance: {distance: 0.1, bearing_deg: 5.0}
 conditions: {time_of_day: 11.0, day_of_year: 250, shadows: true, growth: 0.5,

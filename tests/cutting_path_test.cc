@@ -17,6 +17,7 @@
 #include "trimbot/robot/robot_parameters.h"
 #include "trimbot/trimming/cutting_path.h"
 #include "trimbot/trimming/plan_database.h"
+#include "trimbot/trimming/trim_executive.h"
 
 namespace trimbot::trimming {
 namespace {
@@ -296,6 +297,48 @@ TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
       100.0 * before.surface_within_tolerance, 100.0 * after.surface_within_tolerance,
       100.0 * after.overcut_volume / after.target_volume);
   EXPECT_GT(after.surface_within_tolerance, before.surface_within_tolerance + 0.1);
+}
+
+}  // namespace
+}  // namespace trimbot::trimming
+
+namespace trimbot::trimming {
+namespace {
+
+// A trim that cannot be made ends with the reason, never waits: no leaf points near the expected
+// bush (an empty scan), and a bush out of the arm's reach from where the base stands.
+TEST(TrimExecutive, FailsWithTheReasonOnAnEmptyScanOrABushOutOfReach) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  const auto parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
+  messages::ArmJointState joints;
+  joints.position = parameters.arm_home_position;
+  perception::TopiaryShape bush;
+  bush.centre = {3.0, 0.0, 0.35};
+  bush.half = Eigen::Vector3d::Constant(0.35);
+  // Leaves all round a ball 3 m ahead (the arm reaches about 1 m).
+  std::vector<Eigen::Vector3d> leaves;
+  for (int k = 0; k < 2000; ++k) {
+    const double z = 1.0 - 2.0 * (k + 0.5) / 2000, r = std::sqrt(1.0 - z * z), a = 2.39996 * k;
+    leaves.push_back(bush.centre + 0.37 * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z));
+  }
+  for (const bool empty : {true, false}) {
+    TrimExecutive trim(robot, TrimParameters{});
+    trim.SetJointState(joints);
+    trim.Start(0.0, bush, perception::AxesTied::kAll, 0, Eigen::Isometry3d::Identity());
+    EXPECT_TRUE(trim.WantsPoints());
+    // An empty scan: stereo saw something, but nothing near the bush.
+    trim.SetPerceivedPoints(empty ? std::vector<Eigen::Vector3d>{{1.0, 1.0, 0.5}} : leaves, {});
+    trim.Update(0.1);
+    if (!empty) {
+      ASSERT_EQ(trim.mode(), TrimExecutive::Mode::kFitted) << trim.report().failure;
+      trim.StandsAt(Eigen::Isometry3d::Identity());
+      trim.Update(0.2);
+    }
+    EXPECT_EQ(trim.mode(), TrimExecutive::Mode::kDone);
+    EXPECT_FALSE(trim.report().cut);
+    const std::string why = empty ? "no target shape from the scan" : "no cutting path";
+    EXPECT_NE(trim.report().failure.find(why), std::string::npos) << trim.report().failure;
+  }
 }
 
 }  // namespace

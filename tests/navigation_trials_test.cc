@@ -323,6 +323,37 @@ TEST(Scenario, ApproachBushNeedsABushOfTheGarden) {
   EXPECT_EQ(prepared.goal_truths[0].position, Eigen::Vector2d(1.5, -2.2));
 }
 
+// A trim goal names a topiary (a rose has no target shape), a goal approaches or trims, and stored
+// cutting paths are for trim goals: each refused naming the scenario and the problem.
+TEST(Scenario, TrimBushNeedsATopiaryAndTheDatabaseATrim) {
+  const Scenario rose =
+      Scenario::Load(SmokeVariant("trim_rose.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{trim_bush: 3}"));
+  try {
+    PrepareTrial(rose, ProjectPaths{TRIMBOT_SOURCE_DIR});
+    ADD_FAILURE() << "a rose accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("trim_rose.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("is a rose, not a topiary"), std::string::npos) << e.what();
+  }
+  for (const auto& [replacement, problem] : std::vector<std::pair<std::string, std::string>>{
+           {"{trim_bush: 1, approach_bush: 1}", "approaches, scans or trims a bush, one of them"},
+           {"{x: 4.0, y: 0.0}\ncutting_path_database: paths.sqlite", "is for trim goals"}}) {
+    try {
+      Scenario::Load(SmokeVariant("bad_trim.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", replacement));
+      ADD_FAILURE() << replacement << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad_trim.yaml"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
+    }
+  }
+  const Scenario ok =
+      Scenario::Load(SmokeVariant("trim_ok.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{trim_bush: 1}"));
+  const PreparedTrial prepared = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
+  ASSERT_EQ(prepared.mission.size(), 1u);
+  EXPECT_TRUE(prepared.mission[0].trim);
+  EXPECT_TRUE(prepared.mission[0].bush.has_value());
+}
+
 // A goal that some headings cannot arrive at (the footprint would touch a rose on the last
 // segment): RRT* joins a goal only from its nearest node and failed on this one a third of the
 // time; the planner now arrives from a side that works.

@@ -2,6 +2,7 @@
 // the MuJoCo model against the URDF, contacts with garden objects.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -216,6 +217,64 @@ TEST(Arm, ServosReachAPositionTargetAgainstGravity) {
   const Eigen::Vector3d expected =
       (truth.T_map_base * simulator.robot().FramePose("arm_end_effector", joints)).translation();
   EXPECT_LT((truth.T_map_end_effector.translation() - expected).norm(), 0.01);
+}
+
+// A topiary placed where the blade ends a move (3 cm outside its target, in the leaves grown at
+// 0.35): with the cutter spinning the simulator's foliage is the grown foliage cut by the true blade
+// disc step by step, exactly; with it off nothing is cut.
+garden::Foliage SweepThroughATopiary(bool cutter_on, long* blade_cuts) {
+  const messages::ArmCommand reach = [] {
+    messages::ArmCommand c;
+    c.position = {0.5, 2.4, 1.2, 4.2, 1.44, 1.32};
+    return c;
+  }();
+  SimulatorConfig config = TestConfig(TestLawn(), cutter_on ? "cut_on" : "cut_off");
+  config.conditions.growth = 0.35;
+  config.cuttable_objects = {1};
+  const robot::RobotDescription robot = robot::RobotDescription::Load(config.robot.urdf);
+  std::map<std::string, double> joints;
+  for (size_t i = 0; i < reach.position.size(); ++i)
+    joints[robot::RobotFrames::ArmJoint(static_cast<int>(i))] = reach.position[i];
+  const Eigen::Vector3d blade = robot.FramePose("cutter_blade_link", joints).translation();  // start: map = base
+  garden::GardenObject& bush = *std::find_if(config.garden.objects.begin(), config.garden.objects.end(),
+                                             [](const garden::GardenObject& o) { return o.id == 1; });
+  const Eigen::Vector3d out = Eigen::Vector3d(blade.x(), blade.y(), 0.0).normalized();
+  const garden::Superellipsoid target = garden::TargetShape(bush);
+  const Eigen::Vector3d centre = blade + out * (target.Radius(-out) + 0.03);
+  bush.position = centre.head<2>();
+  bush.base_height = centre.z() - target.half.z();
+  Simulator simulator(config);
+  garden::Foliage offline = *simulator.foliage(1);
+  simulator.SetArmCommand(reach);
+  simulator.SetCutterCommand({cutter_on});
+  SensorOutputs outputs;
+  GroundTruth truth;
+  const auto disc = [&](const GroundTruth& t) {
+    const Eigen::Isometry3d T_map_blade = t.T_map_end_effector * robot.BladeInCutter();
+    return garden::BladeDisc{T_map_blade.translation(), T_map_blade.linear().col(2), robot.BladeRadius()};
+  };
+  garden::BladeDisc last = disc(simulator.ground_truth());
+  while (simulator.time() < 4.0) {
+    outputs.Clear();
+    simulator.Step(&outputs, &truth);
+    if (cutter_on) offline.Cut(last, disc(truth));
+    last = disc(truth);
+  }
+  *blade_cuts = offline.cut_columns();
+  EXPECT_EQ(simulator.foliage(2), nullptr) << "only the trimmed bush is cuttable";
+  int differing = 0;
+  for (int i = 0; i < offline.columns(); ++i) differing += simulator.foliage(1)->radius(i) != offline.radius(i);
+  EXPECT_EQ(differing, 0) << "columns the simulator cut otherwise than the blade's sweep";
+  return *simulator.foliage(1);
+}
+
+TEST(Foliage, TheSpinningBladeCutsWhatItSweepsInTheSimulator) {
+  long cuts_on = 0, cuts_off = 0;
+  const garden::Foliage cut = SweepThroughATopiary(true, &cuts_on);
+  const garden::Foliage uncut = SweepThroughATopiary(false, &cuts_off);
+  EXPECT_GT(cuts_on, 100) << "the blade went through the leaves";
+  EXPECT_EQ(uncut.cut_columns(), 0) << "the cutter was off";
+  EXPECT_LT(cut.Measure().overgrowth_volume, uncut.Measure().overgrowth_volume);
 }
 
 TEST(Contacts, DrivingIntoTheHedgeIsReported) {

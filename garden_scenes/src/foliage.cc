@@ -145,6 +145,8 @@ Foliage Foliage::Grown(const GardenObject& object, std::uint64_t appearance_seed
   const FoliageGrowth grown(object, appearance_seed, growth);
   Foliage foliage;
   foliage.target_ = grown.target();
+  foliage.rings_ = rings;
+  foliage.segments_ = segments;
   const Eigen::Matrix4d T = ObjectPose(object);
   foliage.T_map_centre_.matrix() = T;
   foliage.T_map_centre_.translate(Eigen::Vector3d(0.0, 0.0, foliage.target_.half.z()));
@@ -178,8 +180,27 @@ void Foliage::CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& 
   if ((a + t * ab).norm() > reach + radius) return;
   for (std::size_t i = 0; i < radius_.size(); ++i) {
     const double s = FirstCrossing(direction_[i], radius_[i], a, b, n, radius, root);
-    if (s < radius_[i]) radius_[i] = s;
+    if (s < radius_[i]) {
+      radius_[i] = s;
+      ++cut_columns_;
+    }
   }
+}
+
+double Foliage::RadiusAlong(const Eigen::Vector3d& direction) const {
+  const Eigen::Vector3d d = direction.normalized();
+  const double polar = std::acos(std::clamp(d.z(), -1.0, 1.0));
+  double azimuth = std::atan2(d.y(), d.x());
+  if (azimuth < 0.0) azimuth += 2.0 * M_PI;
+  const int r = std::clamp(static_cast<int>(polar / M_PI * rings_), 0, rings_ - 1);
+  const int s = static_cast<int>(azimuth / (2.0 * M_PI) * segments_) % segments_;
+  return radius_[static_cast<std::size_t>(r * segments_ + s)];
+}
+
+bool Foliage::Reaches(const Eigen::Vector3d& point, double margin) const {
+  const Eigen::Vector3d p = T_map_centre_.inverse() * point;
+  const double distance = p.norm();
+  return distance < 1e-9 || distance <= RadiusAlong(p / distance) + margin;
 }
 
 void Foliage::Cut(const BladeDisc& from, const BladeDisc& to) {
@@ -200,6 +221,11 @@ double Foliage::NormalCosine(std::size_t i) const {
   return std::max(0.1, std::abs(d.dot(target_.Normal(target_radius_[i] * d))));
 }
 
+double Foliage::SurfaceDistance(int i) const {
+  const auto k = static_cast<std::size_t>(i);
+  return (radius_[k] - target_radius_[k]) * NormalCosine(k);
+}
+
 CutQuality Foliage::Measure(double tolerance) const {
   CutQuality q;
   double area = 0.0, within = 0.0;
@@ -211,10 +237,9 @@ CutQuality Foliage::Measure(double tolerance) const {
     q.max_overgrowth = std::max(q.max_overgrowth, r - t);
     // The distance along the target's normal, and the surface element the column's solid angle
     // spans at its radius.
-    const double cosine = NormalCosine(i);
-    const double element = w * r * r / cosine;
+    const double element = w * r * r / NormalCosine(i);
     area += element;
-    if (std::abs((r - t) * cosine) <= tolerance) within += element;
+    if (std::abs(SurfaceDistance(static_cast<int>(i))) <= tolerance) within += element;
   }
   q.surface_within_tolerance = area > 0.0 ? within / area : 0.0;
   return q;
@@ -236,7 +261,7 @@ void Foliage::WritePly(const std::string& path) const {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const float values[4] = {static_cast<float>(points[i].x()), static_cast<float>(points[i].y()),
                              static_cast<float>(points[i].z()),
-                             static_cast<float>((radius_[i] - target_radius_[i]) * NormalCosine(i))};
+                             static_cast<float>(SurfaceDistance(static_cast<int>(i)))};
     char bytes[sizeof(values)];
     std::memcpy(bytes, values, sizeof(values));  // little-endian hosts only (x86-64, arm64)
     out.write(bytes, sizeof(bytes));

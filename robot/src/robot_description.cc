@@ -136,6 +136,15 @@ Eigen::Isometry3d RobotDescription::BladeInCutter() const {
          FramePose(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
 }
 
+double RobotDescription::BladeRadius() const {
+  const auto link = model_->getLink(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
+  const auto* cylinder = link && link->collision && link->collision->geometry
+                             ? dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get())
+                             : nullptr;
+  if (cylinder == nullptr) throw InputError(path_, "the cutter blade's link has no collision cylinder");
+  return cylinder->radius;
+}
+
 std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() const {
   Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector2d high = -low;

@@ -77,6 +77,17 @@ struct AnimatedPlant {
   std::vector<float> vertices;  // as drawn now
 };
 
+// A cuttable topiary: its foliage, and its drawn mesh's vertices as directions from the foliage's
+// centre (the mesh is redrawn with each vertex at most where the foliage now ends).
+struct CuttableTopiary {
+  int object_id = 0;
+  garden::Foliage foliage;
+  int mesh = -1;
+  Eigen::Isometry3d T_mesh_centre = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> rest_in_centre;  // the vertices as built, in the centre frame
+  long drawn_cuts = 0;                          // foliage.cut_columns() when last drawn
+};
+
 struct Simulator::Impl {
   std::unique_ptr<World> world;
   std::unique_ptr<RingRenderer> renderer;
@@ -91,6 +102,10 @@ struct Simulator::Impl {
   std::unique_ptr<ImuModel> imu;
   std::unique_ptr<WheelEncoderModel> encoders;
   bool cutter_on = false;
+  std::vector<CuttableTopiary> topiaries;
+  std::optional<garden::BladeDisc> last_blade;  // the blade at the end of the last step
+  Eigen::Isometry3d T_cutter_blade = Eigen::Isometry3d::Identity();
+  double blade_radius = 0.0;
   long step = 0;
   long frame = 0;
   int imu_steps = 1, encoder_steps = 1, camera_steps = 1;
@@ -117,6 +132,7 @@ Simulator::Simulator(const SimulatorConfig& config)
   options.start = config.start;
   options.conditions = config.conditions;
   options.msaa_samples = config.msaa_samples;
+  options.cuttable_objects = config.cuttable_objects;
   spec_ = ComposeWorld(robot_, rig_, garden_, options, config.world_dir);
   impl_->world = std::make_unique<World>(spec_);
 
@@ -160,6 +176,92 @@ Simulator::Simulator(const SimulatorConfig& config)
     impl_->read_noise = std::make_unique<ReadNoise>(StreamSeed(config.seed, "camera_read_noise"));
     SetUpWeather();
   }
+  SetUpFoliage();
+}
+
+void Simulator::SetUpFoliage() {
+  impl_->T_cutter_blade = robot_.BladeInCutter();
+  impl_->blade_radius = robot_.BladeRadius();
+  const World& world = *impl_->world;
+  const mjModel* m = world.model();
+  const mjData* d = world.data();
+  for (const int id : config_.cuttable_objects) {
+    const auto object = std::find_if(garden_.objects.begin(), garden_.objects.end(),
+                                     [&](const garden::GardenObject& o) { return o.id == id; });
+    if (object == garden_.objects.end() || object->object_class != garden::ObjectClass::kTopiary) {
+      throw std::invalid_argument("Simulator: object " + std::to_string(id) + " is not a topiary of the garden");
+    }
+    CuttableTopiary topiary;
+    topiary.object_id = id;
+    topiary.foliage = garden::Foliage::Grown(*object, garden_.appearance_seed, config_.conditions.growth);
+    for (int g = 0; g < m->ngeom; ++g) {
+      const GeomLabel* label = world.label(g);
+      if (label == nullptr || label->object_id != id || m->geom_type[g] != mjGEOM_MESH || m->geom_contype[g] != 0) {
+        continue;
+      }
+      topiary.mesh = m->geom_dataid[g];
+      const Eigen::Isometry3d T_map_mesh = PoseFromMujoco(d->geom_xpos + 3 * g, d->geom_xmat + 9 * g);
+      topiary.T_mesh_centre = T_map_mesh.inverse() * topiary.foliage.pose();
+      const float* vertex = m->mesh_vert + 3 * m->mesh_vertadr[topiary.mesh];
+      for (int v = 0; v < m->mesh_vertnum[topiary.mesh]; ++v) {
+        topiary.rest_in_centre.push_back(topiary.T_mesh_centre.inverse() *
+                                         Eigen::Vector3d(vertex[3 * v], vertex[3 * v + 1], vertex[3 * v + 2]));
+      }
+    }
+    impl_->topiaries.push_back(std::move(topiary));
+  }
+}
+
+void Simulator::CutFoliage(const GroundTruth& truth) {
+  if (impl_->topiaries.empty()) return;
+  const Eigen::Isometry3d T_map_blade = truth.T_map_end_effector * impl_->T_cutter_blade;
+  garden::BladeDisc blade;
+  blade.centre = T_map_blade.translation();
+  blade.axis = T_map_blade.linear().col(2);
+  blade.radius = impl_->blade_radius;
+  if (impl_->cutter_on && impl_->last_blade) {
+    for (CuttableTopiary& topiary : impl_->topiaries) topiary.foliage.Cut(*impl_->last_blade, blade);
+  }
+  impl_->last_blade = blade;
+}
+
+void Simulator::DrawCutFoliage() {
+  if (!impl_->renderer) return;
+  for (CuttableTopiary& topiary : impl_->topiaries) {
+    if (topiary.mesh < 0 || topiary.foliage.cut_columns() == topiary.drawn_cuts) continue;
+    topiary.drawn_cuts = topiary.foliage.cut_columns();
+    std::vector<float> vertices(3 * topiary.rest_in_centre.size());
+    for (std::size_t v = 0; v < topiary.rest_in_centre.size(); ++v) {
+      const Eigen::Vector3d& rest = topiary.rest_in_centre[v];
+      const double r = rest.norm();
+      const Eigen::Vector3d now =
+          topiary.T_mesh_centre *
+          (r > 0.0 ? Eigen::Vector3d(rest * std::min(1.0, topiary.foliage.RadiusAlong(rest) / r)) : rest);
+      for (int k = 0; k < 3; ++k) vertices[3 * v + static_cast<std::size_t>(k)] = static_cast<float>(now[k]);
+    }
+    // A plant that sways sways about its cut shape.
+    const auto plant = std::find_if(impl_->plants.begin(), impl_->plants.end(),
+                                    [&](const AnimatedPlant& p) { return p.mesh == topiary.mesh; });
+    if (plant != impl_->plants.end()) {
+      const Eigen::Matrix3d& R = plant->R_world_mesh;
+      for (std::size_t v = 0; v < topiary.rest_in_centre.size(); ++v) {
+        const Eigen::Vector3d now(vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]);
+        const Eigen::Vector3d was(plant->rest[3 * v], plant->rest[3 * v + 1], plant->rest[3 * v + 2]);
+        plant->rest_in_world[v] += R * (now - was);
+      }
+      plant->rest = vertices;
+      impl_->weather_time = -1.0;  // moved again at the next draw
+    } else {
+      impl_->renderer->ReplaceMeshVertices(topiary.mesh, vertices);
+    }
+  }
+}
+
+const garden::Foliage* Simulator::foliage(int object_id) const {
+  for (const CuttableTopiary& topiary : impl_->topiaries) {
+    if (topiary.object_id == object_id) return &topiary.foliage;
+  }
+  return nullptr;
 }
 
 void Simulator::SetUpWeather() {
@@ -276,6 +378,7 @@ void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
 
   const bool ring_exposed = cameras_available && impl_->step % impl_->camera_steps == 0;
   *truth = ground_truth();
+  CutFoliage(*truth);
   truth->contacts = ObstacleContacts();
   truth->arm_contacts = ArmContacts();
   truth->ring_exposed = ring_exposed;
@@ -388,6 +491,7 @@ RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool wi
   World& world = *impl_->world;
   mj_forward(world.model(), world.data());  // kinematics at the current time
   const double exposed_at = world.data()->time;
+  DrawCutFoliage();
   SetWeatherFor(exposed_at);
   const GroundTruth now = ground_truth();
   RingCapture capture;
@@ -503,6 +607,8 @@ cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double dist
                                       int width, int height) {
   if (!impl_->renderer) throw std::logic_error("RenderExternalView: the simulator was configured without cameras");
   mj_forward(impl_->world->model(), impl_->world->data());
+  DrawCutFoliage();
+  if (impl_->weather_time < 0.0 && impl_->clouds) SetWeatherFor(impl_->world->data()->time);
   return impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);
 }
 

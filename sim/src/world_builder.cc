@@ -2,6 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 
 #include "mjcf_text.h"
 #include "trimbot/common/atomic_file.h"
+#include "trimbot/garden/foliage.h"
 #include "trimbot/garden/object_mesh.h"
 #include "trimbot/garden/textures.h"
 #include "trimbot/sim/render_pinhole.h"
@@ -131,19 +133,27 @@ class GardenEmitter {
     labels_.push_back({"garden/ground", ObjectClass::kGround, garden::kGroundObjectId, true, garden_.ground});
   }
 
+  // `extra`: more attributes of the geom. A mesh without faces is its vertices' convex hull.
   void Mesh(const std::string& name, const garden::Mesh& mesh, const Eigen::Matrix4d& pose, const std::string& material,
-            const std::string& geom_class) {
+            const std::string& geom_class, const std::string& extra = "") {
     assets_ << "    <mesh name=\"" << name << "\" vertex=\"";
     for (const auto& v : mesh.vertices) assets_ << Num(v.x()) << ' ' << Num(v.y()) << ' ' << Num(v.z()) << ' ';
-    assets_ << "\" texcoord=\"";
-    for (const auto& t : mesh.texcoords) assets_ << Num(t.x()) << ' ' << Num(t.y()) << ' ';
-    assets_ << "\" face=\"";
-    for (const auto& f : mesh.faces) assets_ << f[0] << ' ' << f[1] << ' ' << f[2] << ' ';
-    assets_ << "\"/>\n";
+    assets_ << "\"";
+    if (!mesh.texcoords.empty()) {
+      assets_ << " texcoord=\"";
+      for (const auto& t : mesh.texcoords) assets_ << Num(t.x()) << ' ' << Num(t.y()) << ' ';
+      assets_ << "\"";
+    }
+    if (!mesh.faces.empty()) {
+      assets_ << " face=\"";
+      for (const auto& f : mesh.faces) assets_ << f[0] << ' ' << f[1] << ' ' << f[2] << ' ';
+      assets_ << "\"";
+    }
+    assets_ << "/>\n";
     Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
     iso.matrix() = pose;
     geoms_ << "    <geom name=\"" << name << "\" class=\"" << geom_class << "\" type=\"mesh\" mesh=\"" << name << "\" "
-           << PoseAttributes(iso) << " material=\"" << material << "\"/>\n";
+           << PoseAttributes(iso) << " material=\"" << material << "\"" << extra << "/>\n";
   }
 
   // The lawn's variants at twice the tile: 4 mm a texel for grass, the scale the lawn had as a
@@ -183,10 +193,35 @@ class GardenEmitter {
   void Objects() {
     for (const auto& object : garden_.objects) {
       const std::string name = "garden/" + std::to_string(object.id) + "_" + garden::ToString(object.object_class);
+      const bool cuttable = std::find(options_.cuttable_objects.begin(), options_.cuttable_objects.end(), object.id) !=
+                            options_.cuttable_objects.end();
       Mesh(name, garden::ObjectMesh(object, garden_.appearance_seed, options_.conditions.growth),
-           garden::ObjectPose(object), garden::ToString(garden::MaterialOf(object.object_class)), "garden");
+           garden::ObjectPose(object), garden::ToString(garden::MaterialOf(object.object_class)),
+           cuttable ? "garden_surface" : "garden");
       labels_.push_back({name, object.object_class, static_cast<std::uint16_t>(object.id), false, garden_.ground});
+      if (cuttable) Wood(object, name + "_wood");
     }
+  }
+
+  // A trimmed topiary's wood: its target shape kWoodDepth inside, collided with and not drawn.
+  void Wood(const garden::GardenObject& object, const std::string& name) {
+    const garden::Superellipsoid target = garden::TargetShape(object);
+    garden::Mesh mesh;
+    constexpr int kRings = 12, kSegments = 24;
+    for (int r = 0; r <= kRings; ++r) {
+      for (int s = 0; s < kSegments; ++s) {
+        const double polar = M_PI * r / kRings, azimuth = 2.0 * M_PI * s / kSegments;
+        const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
+                                std::cos(polar));
+        mesh.vertices.push_back(d * std::max(0.01, target.Radius(d) - kWoodDepth) +
+                                Eigen::Vector3d(0, 0, target.half.z()));
+        if (r == 0 || r == kRings) break;  // one vertex at each pole
+      }
+    }
+    // Only the convex hull collides: the vertices are enough (group 3: not drawn).
+    Mesh(name, mesh, garden::ObjectPose(object), garden::ToString(garden::MaterialOf(object.object_class)), "garden",
+         " group=\"3\"");
+    labels_.push_back({name, object.object_class, static_cast<std::uint16_t>(object.id), false, garden_.ground});
   }
 
   const garden::Garden& garden_;

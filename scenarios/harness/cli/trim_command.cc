@@ -18,8 +18,6 @@ void AddTrimCommands(Commands& commands) {
   precompute->add_option("--distances", options->distances, "from base_link's origin to the target's centre, m")
       ->delimiter(',');
   precompute->add_option("--bearings", options->bearings_deg, "of the target's centre from ahead, deg")->delimiter(',');
-  precompute->add_option("--spacing", options->spacing, "m between blade poses")->check(CLI::Range(0.02, 0.5));
-  precompute->add_option("--rolls", options->rolls, "blade rolls tried per pose")->check(CLI::Range(1, 36));
   commands.OnRun(precompute, [options, &commands] { return RunTrimPrecompute(*options, commands.paths()); });
 }
 

@@ -135,6 +135,7 @@ void to_json(nlohmann::json& j, const TrialResult& t) {
     j["arm_goals"] = t.arm_goals;
     j["arm_contacts"] = t.arm_contacts;
   }
+  if (!t.trims.empty()) j["trims"] = t.trims;
 }
 
 void from_json(const nlohmann::json& j, TrialResult& t) {
@@ -165,6 +166,7 @@ void from_json(const nlohmann::json& j, TrialResult& t) {
     j.at("arm_goals").get_to(t.arm_goals);
     j.at("arm_contacts").get_to(t.arm_contacts);
   }
+  if (j.contains("trims")) j.at("trims").get_to(t.trims);
 }
 
 void to_json(nlohmann::json& j, const CriterionResult& c) {
@@ -270,6 +272,37 @@ void AddArmMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metri
   metrics["arm_cutter_path_length_mean_m"] = ErrorStats::From(cutter_path).mean;
 }
 
+// Metrics of trim goals (see ComputeBatchMetrics).
+void AddTrimMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
+  std::vector<double> before, after, overcut, fit, cutting;
+  int trims = 0, succeeded = 0, contacts = 0, touches = 0;
+  for (const TrialResult& trial : trials) {
+    for (const TrimOutcome& trim : trial.trims) {
+      ++trims;
+      succeeded += trim.success ? 1 : 0;
+      contacts += trim.arm_contacts;
+      touches += trim.foliage_touches;
+      before.push_back(trim.within_2cm_before);
+      after.push_back(trim.within_2cm_after);
+      overcut.push_back(trim.overcut_share);
+      if (trim.fit_centre_error_m >= 0.0) fit.push_back(trim.fit_centre_error_m);
+      if (trim.cut) cutting.push_back(trim.cutting_seconds);
+    }
+  }
+  if (trims == 0) return;
+  metrics["trim_goals"] = trims;
+  metrics["trim_success_rate"] = static_cast<double>(succeeded) / trims;
+  metrics["trim_arm_contacts"] = contacts;
+  metrics["trim_foliage_touches"] = touches;
+  metrics["trim_within_2cm_before_mean"] = ErrorStats::From(before).mean;
+  metrics["trim_within_2cm_after_mean"] = ErrorStats::From(after).mean;
+  metrics["trim_within_2cm_after_min"] = *std::min_element(after.begin(), after.end());
+  metrics["trim_overcut_mean"] = ErrorStats::From(overcut).mean;
+  metrics["trim_overcut_max"] = ErrorStats::From(overcut).max;
+  if (!fit.empty()) metrics["trim_fit_centre_error_max_m"] = ErrorStats::From(fit).max;
+  if (!cutting.empty()) metrics["trim_cutting_seconds_mean"] = ErrorStats::From(cutting).mean;
+}
+
 // Localization: the localization rate, the visual localizer's per-frame success and rate, and
 // each estimate's errors (and the EKF's NEES) over the samples pooled from every trial.
 void AddLocalizationMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
@@ -365,6 +398,7 @@ nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int t
   AddLocalizationMetrics(trials, metrics);
   AddBushMetrics(trials, metrics);
   AddArmMetrics(trials, metrics);
+  AddTrimMetrics(trials, metrics);
   return metrics;
 }
 

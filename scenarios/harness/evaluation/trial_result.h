@@ -96,6 +96,40 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ArmGoalOutcome, goal, x, y, z, reached, stack
                                    path_length_rad, cutter_path_length_m, motion_seconds, tracking_error_max_rad,
                                    min_clearance_m, contacts)
 
+// One trim goal's bush (`trim_bush`): its foliage against the target shape before and after
+// (ground truth, van Marrewijk et al.'s measure: the share of the surface within 2 cm), what the
+// stack reported of its trim, its fit against the true target, and what the arm touched meanwhile.
+struct TrimOutcome {
+  int goal = 0;
+  int bush = 0;                    // garden object id
+  bool success = false;            // cut, no arm contact, no link but the blade in the foliage
+  bool cut = false;                // the stack executed its cutting path to the end
+  std::string failure;             // the stack's reason when it did not
+  double within_2cm_before = 0.0;  // share of the foliage surface within 2 cm of the target
+  double within_2cm_after = 0.0;
+  double overcut_share = 0.0;         // of the target's volume cut away
+  double overgrowth_before_m3 = 0.0;  // foliage volume outside the target
+  double overgrowth_after_m3 = 0.0;
+  double cutting_seconds = 0.0;             // simulated, the blade spinning
+  double trim_seconds = 0.0;                // simulated, from the approach's end to the arm back at rest
+  int points = 0;                           // stereo points of the bush the fit used
+  int poses = 0, reached_poses = 0;         // blade poses on the fitted target, and on the path
+  bool from_database = false;               // the path adapted from a stored one
+  double motion_seconds = 0.0;              // the path's move times (the GTSP's cost)
+  double nearest_neighbour_seconds = 0.0;   // the greedy tour's (solved in full only)
+  double fit_centre_error_m = -1.0;         // the fitted centre from the true one (-1: no fit)
+  double fit_axes_error_max_m = -1.0;       // the largest semi-axis error
+  std::vector<double> fit_centre_offset_m;  // fitted - true centre, map frame (x, y, z; empty: no fit)
+  std::vector<double> fit_half_m;           // the fitted semi-axes
+  int arm_contacts = 0;                     // contact events of the arm (MuJoCo: the wood, the ground, itself)
+  int foliage_touches = 0;                  // events of an arm link other than the blade reaching into the foliage
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after,
+                                   overcut_share, overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
+                                   trim_seconds, points, poses, reached_poses, from_database, motion_seconds,
+                                   nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m,
+                                   fit_centre_offset_m, fit_half_m, arm_contacts, foliage_touches)
+
 struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
@@ -126,10 +160,12 @@ struct TrialResult {
   int localization_stopped_updates = 0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
-  std::vector<BushFrame> bush_frames;        // bush goals' sightings
-  std::vector<ArmGoalOutcome> arm_goals;     // arm_reach trials
-  int arm_contacts = 0;                      // arm contact events (MuJoCo), all goals
-  std::vector<double> arm_planning_seconds;  // wall clock per plan: timing.json only, not reproducible
+  std::vector<BushFrame> bush_frames;         // bush goals' sightings
+  std::vector<ArmGoalOutcome> arm_goals;      // arm_reach trials
+  int arm_contacts = 0;                       // arm contact events (MuJoCo), all goals
+  std::vector<double> arm_planning_seconds;   // wall clock per plan: timing.json only, not reproducible
+  std::vector<TrimOutcome> trims;             // trim goals
+  std::vector<double> trim_planning_seconds;  // wall clock per trim (fit and path): timing.json only
 };
 
 // One pass criterion of the scenario, e.g. success_rate >= 1.0.
@@ -181,7 +217,10 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 // bearing}_error_{mean,max}, bush_frame_within_rate (within 5 cm and 3 deg); with arm goals:
 // arm_goals, arm_success_rate, arm_contacts, arm_position_error_{mean,max}_m,
 // arm_orientation_error_{mean,max}_deg (goals the stack reported reached), arm_tracking_error_max_rad,
-// arm_min_clearance_m, arm_path_length_mean_rad, arm_cutter_path_length_mean_m.
+// arm_min_clearance_m, arm_path_length_mean_rad, arm_cutter_path_length_mean_m; with trim goals:
+// trim_goals, trim_success_rate, trim_arm_contacts, trim_foliage_touches,
+// trim_within_2cm_{before_mean,after_mean,after_min}, trim_overcut_{mean,max},
+// trim_fit_centre_error_max_m, trim_cutting_seconds_mean.
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);
 
 }  // namespace trimbot::scenarios

@@ -132,7 +132,18 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
       continue;
     }
     const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario, ApproachBush(goal.bush));
-    goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
+    if (!goal.trim) {
+      goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
+      continue;
+    }
+    if (bush.object_class != garden::ObjectClass::kTopiary) {
+      throw InputError(scenario.source, std::string("goals: ") + (goal.cut ? "trim_bush " : "scan_bush ") +
+                                            std::to_string(goal.bush) + ": object " + std::to_string(goal.bush) +
+                                            " is a " + garden::ToString(bush.object_class) +
+                                            ", not a topiary (only topiaries have a target shape to trim to)");
+    }
+    goals.push_back(goal.cut ? stack::Goal::TrimBush(bush.position, ShapeOf(bush))
+                             : stack::Goal::ScanBush(bush.position, ShapeOf(bush)));
   }
   return goals;
 }

@@ -139,8 +139,13 @@ void ReadMission(const YamlMap& root, Scenario& s) {
   for (const YamlMap& goal :
        root.Has("goals") || !root.Has("arm_reach") ? root.MapList("goals") : std::vector<YamlMap>{}) {
     ScenarioGoal g;
-    if (goal.Has("approach_bush")) {
-      g.bush = goal.Integer("approach_bush", 1, garden::kMaxGardenObjectId);  // checked against the garden later
+    const int kinds = goal.Has("approach_bush") + goal.Has("trim_bush") + goal.Has("scan_bush");
+    if (kinds > 1) goal.Fail("trim_bush", "a goal approaches, scans or trims a bush, one of them");
+    if (kinds == 1) {
+      g.trim = !goal.Has("approach_bush");
+      g.cut = goal.Has("trim_bush");
+      const char* key = g.cut ? "trim_bush" : g.trim ? "scan_bush" : "approach_bush";
+      g.bush = goal.Integer(key, 1, garden::kMaxGardenObjectId);  // checked against the garden later
       if (goal.Has("yaw_deg")) goal.Fail("yaw_deg", "a bush goal's heading is the bush's bearing (give none)");
     } else {
       g.position = {goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m")};
@@ -189,6 +194,14 @@ void ReadMission(const YamlMap& root, Scenario& s) {
   }
   if (root.Has("calibration_error")) s.calibration_error = ReadCalibrationError(root.Map("calibration_error"));
   if (root.Has("visual_map")) ReadVisualMap(root, s);
+  if (root.Has("cutting_path_database")) {
+    const std::filesystem::path path = root.String("cutting_path_database");
+    s.cutting_path_database =
+        (path.is_absolute() ? path : std::filesystem::path(s.source).parent_path() / path).string();
+    if (std::none_of(s.goals.begin(), s.goals.end(), [](const ScenarioGoal& g) { return g.cut; })) {
+      root.Fail("cutting_path_database", "is for trim goals (trim_bush), and the scenario has none");
+    }
+  }
 }
 
 void ReadPlant(const YamlMap& root, Scenario& s) {
@@ -266,6 +279,9 @@ bool IsKnownMetric(const std::string& name) {
     names.insert({"arm_goals", "arm_success_rate", "arm_contacts", "arm_tracking_error_max_rad", "arm_min_clearance_m",
                   "arm_position_error_mean_m", "arm_position_error_max_m", "arm_orientation_error_mean_deg",
                   "arm_orientation_error_max_deg", "arm_path_length_mean_rad", "arm_cutter_path_length_mean_m"});
+    names.insert({"trim_goals", "trim_success_rate", "trim_arm_contacts", "trim_foliage_touches",
+                  "trim_within_2cm_before_mean", "trim_within_2cm_after_mean", "trim_within_2cm_after_min",
+                  "trim_overcut_mean", "trim_overcut_max", "trim_fit_centre_error_max_m", "trim_cutting_seconds_mean"});
     for (const char* bush : {"bush_distance_error", "bush_bearing_error", "bush_estimate_distance_error",
                              "bush_estimate_bearing_error", "bush_frame_distance_error", "bush_frame_bearing_error"}) {
       names.insert(std::string(bush) + "_mean");

@@ -62,11 +62,16 @@ struct Survey {
 // Errors of the calibration the stack reads (the simulator renders with the true one). Seeded
 // per trial; each a standard deviation.
 // A goal of the mission: a point in the map frame, or a bush of the garden to approach for
-// trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff).
+// trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff), or to
+// approach and trim from the standoff (`trim_bush: ID`, a topiary; the same bush from several
+// standoffs: point goals between them lead the base round it), or to approach and scan only
+// (`scan_bush: ID`: the scan joins the bush's later trims' fits).
 struct ScenarioGoal {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's (a bush's: see MissionGoals)
   std::optional<double> yaw;                           // rad, map frame (`yaw_deg`): a point goal's heading; unset: any
   int bush = 0;                                        // the garden object's id; 0: a point goal
+  bool trim = false;                                   // scanned once approached (`scan_bush`) ...
+  bool cut = false;                                    // ... and trimmed (`trim_bush`)
 };
 
 // How far a goal's heading may be off when the scenario gives one: Nav2's default
@@ -123,6 +128,9 @@ struct Scenario {
   double initial_yaw_sigma = kInitialYawSigma;            // rad
   CalibrationError calibration_error;
   std::string visual_map;  // map file for localization: visual (relative to this file)
+  // Stored cutting paths for trim goals (`cutting_path_database:`, relative to this file; made by
+  // trimbot trim precompute); empty: each cutting path is solved in full.
+  std::string cutting_path_database;
   // Or the mapping drive the map is built from on first use (then cached; the batch sets
   // visual_map to the cached file before any trial runs).
   std::optional<MapRecipe> visual_map_recipe;

@@ -7,6 +7,7 @@
 
 #include "evaluation/arm_reach.h"
 #include "evaluation/trial_evaluator.h"
+#include "evaluation/trim_evaluator.h"
 #include "loop/closed_loop.h"
 #include "loop/pilots.h"
 #include "loop/prior_knowledge.h"
@@ -14,6 +15,7 @@
 #include "reports/localization_timing.h"
 #include "reports/output_files.h"
 #include "reports/run_timing.h"
+#include "reports/trim_plot.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
 #include "trimbot/stack/robot_stack.h"
@@ -45,13 +47,43 @@ sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   config.wheel_slip_scale = scenario.wheel_slip_scale;
   config.motion_blur = scenario.motion_blur;
   config.camera_time_offset = CameraImuTimeOffset(scenario.calibration_error);
+  config.cuttable_objects = TrimBushes(scenario);
   return config;
 }
 
+// A view of each trim bush from above, 60 deg round from the side the robot starts on (the robot
+// comes between the bush and a view from that side).
+std::vector<cv::Mat> RenderTrimBushes(sim::Simulator& simulator, const Scenario& scenario) {
+  std::vector<cv::Mat> views;
+  for (const int bush : TrimBushes(scenario)) {
+    const Eigen::Vector3d centre = simulator.foliage(bush)->pose().translation();
+    const Eigen::Vector2d towards =
+        centre.head<2>() - Eigen::Vector2d(scenario.setting.start.x, scenario.setting.start.y);
+    const double azimuth = std::atan2(towards.y(), towards.x()) * 180.0 / M_PI + 60.0;
+    views.push_back(simulator.RenderExternalView(centre, 2.2, azimuth, -35.0, 640, 480));
+  }
+  return views;
+}
+
+// Per trim bush: the foliage (PLY), its distance to the target before and after, the views.
+void WriteTrimFiles(const std::string& dir, const TrimEvaluator& evaluator, sim::Simulator& simulator,
+                    const Scenario& scenario, const std::vector<cv::Mat>& views_before) {
+  evaluator.WriteFiles(dir);
+  const std::vector<int> bushes = TrimBushes(scenario);
+  const std::vector<cv::Mat> views_after = RenderTrimBushes(simulator, scenario);
+  for (std::size_t k = 0; k < bushes.size(); ++k) {
+    const std::string id = std::to_string(bushes[k]);
+    WriteTrimDistanceMap(dir + "/trim_" + id + "_distance.png", evaluator.before(bushes[k]),
+                         *simulator.foliage(bushes[k]));
+    WriteBeforeAfter(dir + "/trim_" + id + "_views.png", views_before[k], views_after[k]);
+  }
+}
+
 void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t,
-                 const std::vector<double>& arm_planning_seconds) {
+                 const TrialResult& result) {
   nlohmann::json timing = ToJson(run);
-  if (!arm_planning_seconds.empty()) timing["arm_planning_seconds"] = arm_planning_seconds;
+  if (!result.arm_planning_seconds.empty()) timing["arm_planning_seconds"] = result.arm_planning_seconds;
+  if (!result.trim_planning_seconds.empty()) timing["trim_planning_seconds"] = result.trim_planning_seconds;
   if (!t.plans.empty()) timing["navigation_planning_seconds"] = t.plans;
   WriteRunTimingChart(dir + "/timing.png", "where the trial's time went", run);
   if (!t.visual_frames.empty()) {
@@ -117,7 +149,7 @@ TrialResult RunArmReachTrial(const TrialSetup& setup, const std::function<void(d
   const RunTiming run =
       MakeRunTiming(result.wall_seconds, result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
                     seconds(wall_start, loop_start), seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings, result.arm_planning_seconds);
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result);
   return result;
 }
 
@@ -149,6 +181,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   robot.SetMap(setup.map_yaml);
   if (visual) robot.SetVisualMap(scenario.visual_map);
   robot.SetGoals(mission);
+  if (!scenario.cutting_path_database.empty()) robot.SetCuttingPathDatabase(scenario.cutting_path_database);
 
   std::optional<SimulatedPoseFixes> fixes;
   if (parameters.localization == stack::LocalizationSource::kSimulatedPoseFixes) {
@@ -170,13 +203,17 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   options.pose_fixes = fixes ? &*fixes : nullptr;
   options.render_on_demand = uses_images;
   options.progress = progress;
+  TrimEvaluator trims(simulator, scenario);
+  const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
   const auto loop_start = std::chrono::steady_clock::now();
-  const bool finished = RunClosedLoop(simulator, pilot, {&evaluator}, options);
+  const bool finished = RunClosedLoop(simulator, pilot, {&evaluator, &trims}, options);
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
+  trims.Finish(&result);
   result.simulated_seconds = simulator.time();
   const auto report_start = std::chrono::steady_clock::now();
   evaluator.WriteFiles(setup.dir);
+  WriteTrimFiles(setup.dir, trims, simulator, scenario, trim_views);
   if (parameters.obstacles.enabled) WriteCostmapImage(setup.dir + "/costmap.png", robot.CostmapLayers());
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   WriteFileAtomically(setup.dir + "/result.json", nlohmann::json(result).dump(2));
@@ -185,7 +222,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   const RunTiming run =
       MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
                     seconds(wall_start, loop_start), seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings, {});
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result);
   return result;
 }
 

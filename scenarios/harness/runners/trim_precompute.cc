@@ -8,6 +8,7 @@
 #include "trimbot/common/input_error.h"
 #include "trimbot/robot/collision_model.h"
 #include "trimbot/robot/robot_parameters.h"
+#include "trimbot/stack/stack_parameters.h"
 #include "trimbot/trimming/plan_database.h"
 
 namespace trimbot::scenarios {
@@ -48,10 +49,13 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
   const auto parameters = robot::RobotParameters::Load(files.robot_parameters);
   const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(parameters.arm_home_position.data(), 6);
   const Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
-  trimming::CuttingPoseOptions pose_options;
-  pose_options.spacing = options.spacing;
-  trimming::CuttingPathOptions path_options;
-  path_options.rolls = options.rolls;
+  // The stack's own: stored paths are the ones it would plan.
+  const trimming::TrimParameters trim = stack::StackParameters::Load(files.stack_parameters).Trim();
+  trimming::CuttingPathOptions path_options = trim.path;
+  path_options.velocity_scale = trim.planner.velocity_scale;
+  path_options.acceleration = trim.planner.acceleration;
+  path_options.ik = trim.planner.ik;
+  path_options.search = trimming::GtspSearchOptions{};  // offline: GLNS's default mode in full
   trimming::CuttingPathDatabase database;
   for (std::size_t s = 0; s < shapes.size(); ++s) {
     for (double size : options.sizes) {
@@ -62,9 +66,10 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
           const double b = bearing * M_PI / 180.0;
           target.centre = {distance * std::cos(b), distance * std::sin(b), target.half.z()};
           const auto start = std::chrono::steady_clock::now();
-          const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(kinematics, &collision, target);
+          const trimming::CuttingChecks checks =
+              trimming::MakeCuttingChecks(kinematics, &collision, target, trim.tolerance, trim.planner.collision_step);
           const trimming::CuttingPath path =
-              trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target, pose_options),
+              trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target, trim.poses),
                                         checks.valid, checks.free_move, path_options);
           const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           std::printf("[trim] %s %.2f m at %.2f m, %+.0f deg: ", options.shapes[s].c_str(), size, distance, bearing);

@@ -16,8 +16,7 @@ struct TrimPrecomputeOptions {
   std::vector<double> sizes{0.5, 0.7};       // m: the target's width (and height)
   std::vector<double> distances{0.85, 1.0};  // m: from base_link's origin to the target's centre
   std::vector<double> bearings_deg{0.0};     // of the target's centre from the base's x axis
-  double spacing = 0.08;                     // m between blade poses
-  int rolls = 6;                             // blade rolls per pose
+  // Blade poses, rolls, tolerance and the arm's speeds: the stack's (robot/config/stack.yaml trim, arm).
 };
 
 // Exit code: kExitSuccess, kExitBadInput (an unknown shape, a size or distance out of range).

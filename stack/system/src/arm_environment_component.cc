@@ -11,8 +11,9 @@ void ArmEnvironmentComponent::Prepare(bool arm_goals, const robot::CameraRig& ri
 }
 
 bool ArmEnvironmentComponent::Due(double /*stamp*/, const StackState& state) const {
-  if (!state.mission.has_arm_goals() || !state.arm.WantsEnvironment()) return false;
-  return state.mission.NavigationGoalsDone() && std::abs(state.last_linear_command) < 1e-9;
+  const bool arm = state.mission.has_arm_goals() && state.arm.WantsEnvironment() && state.mission.NavigationGoalsDone();
+  const bool trim = state.mission.trimming() && state.trim.WantsPoints();
+  return (arm || trim) && std::abs(state.last_linear_command) < 1e-9;
 }
 
 messages::RingRequest ArmEnvironmentComponent::Request(const StackState& state) const {
@@ -28,7 +29,11 @@ void ArmEnvironmentComponent::Consume(const messages::RingFrame& frame, StackSta
     for (std::size_t i = 0; i < cloud.size(); ++i) seen.Add(cloud.points[i], cloud.covariances[i]);
   }
   if (seen.empty()) return;  // no pair delivered: the next frame
-  state->arm.SetPerceivedPoints(seen.points, seen.covariances);
+  if (state->mission.trimming()) {
+    state->trim.SetPerceivedPoints(seen.points, seen.covariances);
+  } else {
+    state->arm.SetPerceivedPoints(seen.points, seen.covariances);
+  }
   ++telemetry->timings.arm_frames;
 }
 

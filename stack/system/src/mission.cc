@@ -54,17 +54,34 @@ Goal Goal::ApproachBush(const Eigen::Vector2d& centre, const perception::BushSha
   return goal;
 }
 
+Goal Goal::TrimBush(const Eigen::Vector2d& centre, const perception::BushShape& shape) {
+  Goal goal = ScanBush(centre, shape);
+  goal.cut = true;
+  return goal;
+}
+
+Goal Goal::ScanBush(const Eigen::Vector2d& centre, const perception::BushShape& shape) {
+  Goal goal = ApproachBush(centre, shape);
+  goal.trim = true;
+  return goal;
+}
+
 bool HasBushGoal(const std::vector<Goal>& goals) {
   return std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.bush.has_value(); });
 }
 
+bool HasTrimGoal(const std::vector<Goal>& goals) {
+  return std::any_of(goals.begin(), goals.end(), [](const Goal& g) { return g.trim; });
+}
+
 Mission::Mission(const StackParameters& parameters, const Eigen::Vector2d& arm_axis, const Ekf& ekf,
-                 const GyroOdometry& servo_odometry, arm::ArmExecutive* arm)
+                 const GyroOdometry& servo_odometry, arm::ArmExecutive* arm, trimming::TrimExecutive* trim)
     : parameters_(parameters),
       arm_axis_(arm_axis),
       ekf_(ekf),
       servo_odometry_(servo_odometry),
       arm_(arm),
+      trim_(trim),
       servo_(parameters.bush_approach.servo, arm_axis) {}
 
 void Mission::SetGoals(const std::vector<Goal>& goals) {
@@ -195,14 +212,95 @@ void Mission::FinishBushGoal(double stamp, bool reached, const std::string& deta
     failed_ = true;
     return;
   }
+  if (goals_[static_cast<std::size_t>(bush_goal_)].trim) {
+    StartTrim(stamp);
+    return;
+  }
   next_goal_ = bush_goal_ + 1;
   StartSegment(navigator);  // the rest of the mission (none: the navigator is done)
 }
 
+void Mission::StartTrim(double stamp) {
+  const Goal& goal = goals_[static_cast<std::size_t>(bush_goal_)];
+  const perception::BushShape& bush = *goal.bush;
+  perception::TopiaryShape expected;
+  // The plan's shape: exponents as the garden's topiary shapes have them (topiary_fit.h).
+  expected.horizontal_exponent = bush.kind == perception::BushShape::Kind::kBox ? 6.0 : 2.0;
+  expected.vertical_exponent = bush.kind == perception::BushShape::Kind::kEllipsoid ? 2.0 : 6.0;
+  const Eigen::Vector2d centre = Apply(ToIsometry(servo_odometry_.pose()).inverse(), servo_.centre());
+  expected.half = bush.size / 2.0;
+  expected.centre = Eigen::Vector3d(centre.x(), centre.y(), bush.base_height + expected.half.z());
+  expected.yaw = WrapAngle(bush.yaw - ekf_.Estimate().pose.yaw);
+  // Extents that differ by less than a tape survey's error (2 cm a point, two points an extent:
+  // kSurveyTolerance) are one: the plan's ball or round shape.
+  constexpr double kSurveyTolerance = 0.05;  // m
+  const bool round = std::abs(bush.size.x() - bush.size.y()) < kSurveyTolerance;
+  const perception::AxesTied tied = round && std::abs(bush.size.x() - bush.size.z()) < kSurveyTolerance
+                                        ? perception::AxesTied::kAll
+                                    : round ? perception::AxesTied::kHorizontal
+                                            : perception::AxesTied::kNone;
+  // The bush by the first goal that names it (its surveyed centre): trims of it share their scans.
+  int bush_id = bush_goal_;
+  for (int i = 0; i < bush_goal_; ++i) {
+    const Goal& other = goals_[static_cast<std::size_t>(i)];
+    if (other.bush && other.position == goal.position) {
+      bush_id = i;
+      break;
+    }
+  }
+  trim_->Start(stamp, expected, tied, bush_id, ToIsometry(ekf_.Estimate().pose), goal.cut);
+  trimming_ = true;
+  advance_from_ = servo_odometry_.pose();
+  advance_stopped_ = -1.0;
+}
+
+bool Mission::AdvanceToTrim(messages::RobotCommands* commands) {
+  const BushServoParameters& servo = parameters_.bush_approach.servo;
+  const double advance = servo.surface_gap - parameters_.trim.surface_gap;
+  const Pose2 now = servo_odometry_.pose();
+  const double remaining = advance - std::hypot(now.x - advance_from_.x, now.y - advance_from_.y);
+  messages::BaseVelocityCommand command;
+  if (remaining > servo.distance_tolerance) {
+    command.linear = std::clamp(servo.gain * remaining, servo.min_speed, servo.max_speed);
+    commands->base = command;
+    return false;
+  }
+  commands->base = command;
+  return true;
+}
+
+void Mission::RunTrim(double stamp, Navigator* navigator, messages::RobotCommands* commands, Telemetry* telemetry) {
+  ScopedTimer timer(&telemetry->timings.arm);
+  commands->base = messages::BaseVelocityCommand{};
+  if (trim_->mode() == trimming::TrimExecutive::Mode::kFitted) {
+    // Scanned from the approach's standoff (the whole bush in view), cut from closer. Once there,
+    // the base settles (as at the servo's arrival).
+    if (!AdvanceToTrim(commands)) {
+      advance_stopped_ = -1.0;
+    } else if (advance_stopped_ < 0.0) {
+      advance_stopped_ = stamp;
+    } else if (stamp - advance_stopped_ >= parameters_.bush_approach.servo.settle_time) {
+      trim_->StandsAt(ToIsometry(servo_odometry_.pose()).inverse() * ToIsometry(advance_from_));
+    }
+  }
+  if (auto command = trim_->Update(stamp)) commands->arm = *command;
+  commands->cutter = messages::CutterCommand{trim_->cutting()};
+  telemetry->trim = TrimStatus{bush_goal_, trimming::ToString(trim_->mode())};
+  if (trim_->active()) return;
+  telemetry->trim_results.push_back({bush_goal_, trim_->report()});
+  telemetry->trim.reset();
+  trimming_ = false;
+  next_goal_ = bush_goal_ + 1;
+  StartSegment(navigator);
+}
+
 void Mission::UpdateTelemetry(const Navigator& navigator, Telemetry* telemetry) {
-  state_ = failed_ ? MissionState::kFailed : servoing_ ? MissionState::kDriving : ToMission(navigator.mode());
+  state_ = failed_     ? MissionState::kFailed
+           : trimming_ ? MissionState::kReaching
+           : servoing_ ? MissionState::kDriving
+                       : ToMission(navigator.mode());
   telemetry->mission = state_;
-  telemetry->current_goal = servoing_ || failed_ ? bush_goal_ : navigator.current_goal();
+  telemetry->current_goal = servoing_ || trimming_ || failed_ ? bush_goal_ : navigator.current_goal();
   if (bush_goal_ < 0) {
     telemetry->bush.reset();
     return;

@@ -17,16 +17,18 @@
 #include "trimbot/stack/stack_parameters.h"
 #include "trimbot/stack/telemetry.h"
 #include "trimbot/stack/wheel_odometry.h"
+#include "trimbot/trimming/trim_executive.h"
 
 namespace trimbot::stack {
 
 bool HasBushGoal(const std::vector<Goal>& goals);
+bool HasTrimGoal(const std::vector<Goal>& goals);
 
 class Mission {
  public:
   // Reads the pose estimate and the servo's odometry, and drives the arm; all outlive the mission.
   Mission(const StackParameters& parameters, const Eigen::Vector2d& arm_axis, const Ekf& ekf,
-          const GyroOdometry& servo_odometry, arm::ArmExecutive* arm);
+          const GyroOdometry& servo_odometry, arm::ArmExecutive* arm, trimming::TrimExecutive* trim);
 
   // Replaces the goals, from the first; StartSegment gives them to the navigator.
   void SetGoals(const std::vector<Goal>& goals);
@@ -41,6 +43,10 @@ class Mission {
   // Per control tick instead of the navigator while servoing: the servo's command. The bush goal
   // is reached or failed here; once reached, the next segment starts.
   void RunBushServo(double stamp, Navigator* navigator, messages::RobotCommands* commands, Telemetry* telemetry);
+  // Per control tick instead of the navigator while trimming: the base stands for the scan,
+  // advances to the trim's standoff once the target is fitted, and stands while the trim commands
+  // the arm and the cutter. Once the trim is over, the next segment starts.
+  void RunTrim(double stamp, Navigator* navigator, messages::RobotCommands* commands, Telemetry* telemetry);
   // Per control tick, after the base's command: the mission's state, current goal and bush approach.
   void UpdateTelemetry(const Navigator& navigator, Telemetry* telemetry);
   // Per control tick with arm goals, after the base's: once the navigation goals are done, the
@@ -60,22 +66,29 @@ class Mission {
   Eigen::Isometry3d MapFromServoFrame() const;
 
   bool servoing() const { return servoing_; }
+  bool trimming() const { return trimming_; }
   bool has_arm_goals() const { return arm_goals_; }
   // No navigation goals, or they are done (the arm's goals come after them).
   bool NavigationGoalsDone() const;
 
  private:
+  // Straight ahead on the servo's odometry from the approach's standoff to the trim's (closer: the
+  // arm must reach round the bush); true once there (the base commanded to stop).
+  bool AdvanceToTrim(messages::RobotCommands* commands);
   // base_link's position from which, turned to face the bush, the arm's axis is approach_margin
   // beyond the standoff.
   Eigen::Vector2d ApproachPoint(const Goal& goal, const Eigen::Vector2d& from, const Navigator& navigator) const;
   void FinishBushGoal(double stamp, bool reached, const std::string& detail, Navigator* navigator,
                       Telemetry* telemetry);
+  // The bush goal's bush as a target in base_link (the servo's track, the survey's shape and yaw).
+  void StartTrim(double stamp);
 
   const StackParameters& parameters_;
   Eigen::Vector2d arm_axis_;
   const Ekf& ekf_;
   const GyroOdometry& servo_odometry_;
   arm::ArmExecutive* arm_;
+  trimming::TrimExecutive* trim_;
   BushServo servo_;
   // Goals before next_goal_ are done; bush_goal_ is the bush goal of the current segment (-1:
   // none), servoing_ whether its visual servoing has started.
@@ -83,6 +96,9 @@ class Mission {
   int next_goal_ = 0;
   int bush_goal_ = -1;
   bool servoing_ = false;
+  bool trimming_ = false;          // from the bush approach's end to the trim's
+  Pose2 advance_from_;             // the servo frame's pose where the approach ended (the scan's)
+  double advance_stopped_ = -1.0;  // s: stopped at the trim's standoff (-1: not yet)
   bool failed_ = false;
   BushApproachStatus bush_status_;
   bool arm_goals_ = false;                    // SetArmGoals was given goals

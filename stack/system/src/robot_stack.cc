@@ -73,10 +73,19 @@ RobotStack::RobotStack(const robot::RobotFiles& files, const StackParameters& pa
   }
   // The standoff must leave the base's front clear of the bush's surveyed outline.
   const double front = components_->state.outline.max().x() - components_->state.arm_axis.x();
-  if (parameters_.bush_approach.servo.surface_gap < front + parameters_.navigation.stop_clearance) {
-    throw std::invalid_argument("stack parameters: bush_approach.servo.surface_gap must be at least " +
-                                std::to_string(front + parameters_.navigation.stop_clearance) +
-                                " m (the base's front from the arm's axis, plus navigation.stop_clearance)");
+  for (const auto& [key, gap] :
+       {std::pair{"bush_approach.servo.surface_gap", parameters_.bush_approach.servo.surface_gap},
+        std::pair{"trim.surface_gap", parameters_.trim.surface_gap}}) {
+    if (gap < front + parameters_.navigation.stop_clearance) {
+      throw std::invalid_argument(std::string("stack parameters: ") + key + " must be at least " +
+                                  std::to_string(front + parameters_.navigation.stop_clearance) +
+                                  " m (the base's front from the arm's axis, plus navigation.stop_clearance)");
+    }
+  }
+  if (parameters_.trim.surface_gap > parameters_.bush_approach.servo.surface_gap) {
+    throw std::invalid_argument(
+        "stack parameters: trim.surface_gap must not exceed bush_approach.servo.surface_gap (the base advances "
+        "from the approach's standoff to the trim's)");
   }
   next_control_ = 1.0 / parameters_.control_rate_hz;
 }
@@ -142,9 +151,12 @@ void RobotStack::SetGoals(const std::vector<Goal>& goals) {
   }
   state.mission.SetGoals(goals);
   components_->bush.Prepare(goals, state.rig);
+  components_->arm_environment.Prepare(state.mission.has_arm_goals() || HasTrimGoal(goals), state.rig);
   state.mission.StartSegment(state.navigator.get());
   teleop_.reset();
 }
+
+void RobotStack::SetCuttingPathDatabase(const std::string& path) { components_->state.trim.SetDatabase(path); }
 
 void RobotStack::SetTeleopCommand(const messages::BaseVelocityCommand& command) { teleop_ = command; }
 
@@ -165,7 +177,10 @@ void RobotStack::Add(const messages::WheelTicks& ticks) {
   state.servo_odometry.AddWheelTicks(ticks);
 }
 
-void RobotStack::Add(const messages::ArmJointState& joints) { components_->state.arm.SetJointState(joints); }
+void RobotStack::Add(const messages::ArmJointState& joints) {
+  components_->state.arm.SetJointState(joints);
+  components_->state.trim.SetJointState(joints);
+}
 
 void RobotStack::Add(const messages::RingFrame& frame) {
   ++telemetry_.ring_frames;
@@ -200,6 +215,7 @@ messages::RobotCommands RobotStack::Update(double stamp) {
   telemetry_.bush_sightings = components_->bush.TakeSightings();
   telemetry_.visual_attempts = components_->visual.TakeAttempts();
   telemetry_.arm_results.clear();
+  telemetry_.trim_results.clear();
   components_->visual.DeliverFixes(stamp, &state.ekf, &telemetry_);
   if (stamp + 1e-9 >= next_control_) {
     // Control ticks at whole multiples of the period (no drift from summing periods).
@@ -225,7 +241,9 @@ void RobotStack::RunNavigation(double stamp, messages::RobotCommands* commands) 
   if (navigator == nullptr) return;
   const double planning_before = navigator->planning_seconds();
   const auto start = std::chrono::steady_clock::now();
-  if (state.mission.servoing()) {
+  if (state.mission.trimming()) {
+    state.mission.RunTrim(stamp, navigator, commands, &telemetry_);
+  } else if (state.mission.servoing()) {
     // On odometry and stereo alone: the servo needs no map pose.
     state.mission.RunBushServo(stamp, navigator, commands, &telemetry_);
   } else if (components_->visual.Lost(state.ekf)) {

@@ -249,6 +249,26 @@ void ReadArm(Reader& r, arm::ArmExecutiveParameters& p) {
   });
 }
 
+void ReadTrim(Reader& r, trimming::TrimParameters& p) {
+  r.Number("surface_gap", &p.surface_gap, 0.0, 3.0, "m");
+  r.Number("scan_margin", &p.scan_margin, 0.0, 2.0, "m");
+  r.Number("min_height", &p.min_height, 0.0, 1.0, "m");
+  r.Number("max_point_sigma", &p.max_point_sigma, 1e-4, 10.0, "m");
+  r.Integer("max_points", &p.max_points, 10, 10000000);
+  r.Number("fit_quantile", &p.fit.quantile, 0.01, 0.99);
+  r.Number("pose_spacing", &p.poses.spacing, 0.01, 1.0, "m");
+  r.Degrees("max_facing_angle_deg", &p.poses.max_facing_angle, 1.0, 180.0);
+  r.Number("min_blade_height", &p.poses.min_height, 0.0, 2.0, "m");
+  r.Integer("rolls", &p.path.rolls, 1, 360);
+  r.Integer("search_restarts", &p.path.search.restarts, 1, 1000);
+  r.Integer("search_warm_restarts", &p.path.search.warm_restarts, 0, 1000);
+  r.Number("tolerance", &p.tolerance, 0.0, 0.2, "m");
+  r.Number("blade_depth", &p.blade_depth, 0.0, 0.2, "m");
+  if (p.blade_depth > p.tolerance)
+    r.map().Fail("blade_depth", "must not exceed tolerance (the collision checks' depth)");
+  r.Number("database_max_distance", &p.database_max_distance, 0.0, 10.0, "m");
+}
+
 void ReadLocalization(const YamlMap& map, LocalizationSource* source) {
   const std::string name = map.String("localization");
   if (name == "none") {
@@ -273,6 +293,7 @@ void Read(Reader& r, StackParameters& s) {
   r.Section("navigation", [&](Reader& f) { ReadNavigation(f, s); });
   r.Section("bush_approach", [&](Reader& f) { ReadBushApproach(f, s.bush_approach); });
   r.Section("arm", [&](Reader& f) { ReadArm(f, s.arm); });
+  r.Section("trim", [&](Reader& f) { ReadTrim(f, s.trim); });
   r.Section("perception", [&](Reader& perception) {
     perception.Section("local_fusion", [&](Reader& f) {
       perception::LocalFusionOptions& p = s.local_fusion;
@@ -286,6 +307,14 @@ void Read(Reader& r, StackParameters& s) {
 }
 
 }  // namespace
+
+trimming::TrimParameters StackParameters::Trim() const {
+  trimming::TrimParameters p = trim;
+  p.planner = arm.planner;
+  p.settle_tolerance = arm.settle_tolerance;
+  p.settle_timeout = arm.settle_timeout;
+  return p;
+}
 
 const char* ToString(LocalizationSource source) {
   switch (source) {

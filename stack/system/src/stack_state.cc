@@ -14,6 +14,7 @@ StackState::StackState(const robot::RobotFiles& files, const StackParameters& pa
       ekf(parameters.ekf, description.drive(), ticks_per_revolution),
       arm_axis(description.FramePose(robot::RobotFrames::kCameraRing).translation().head<2>()),
       arm(description, parameters.arm),
-      mission(parameters, arm_axis, ekf, servo_odometry, &arm) {}
+      trim(description, parameters.Trim()),
+      mission(parameters, arm_axis, ekf, servo_odometry, &arm, &trim) {}
 
 }  // namespace trimbot::stack

@@ -16,6 +16,7 @@
 #include "trimbot/stack/occupancy_grid.h"
 #include "trimbot/stack/stack_parameters.h"
 #include "trimbot/stack/wheel_odometry.h"
+#include "trimbot/trimming/trim_executive.h"
 
 namespace trimbot::stack {
 
@@ -37,6 +38,7 @@ struct StackState {
   std::unique_ptr<Navigator> navigator;  // made with the map
   Eigen::Vector2d arm_axis;              // base_link: the arm's base (the ring's centre)
   arm::ArmExecutive arm;
+  trimming::TrimExecutive trim;
   Mission mission;
   double last_linear_command = 0.0;  // m/s: its sign is the direction of travel
 };

@@ -83,10 +83,24 @@ class Foliage {
   // property `distance`), written atomically.
   void WritePly(const std::string& path) const;
 
+  // Where the foliage ends along a unit direction from the centre (centre frame): the nearest
+  // column's radius.
+  double RadiusAlong(const Eigen::Vector3d& direction) const;
+  // Whether a map point lies within `margin` of the foliage (inside it, or that close outside).
+  bool Reaches(const Eigen::Vector3d& point, double margin = 0.0) const;
+  // Columns shortened by cuts so far (a drawing of the foliage is stale when it grew).
+  long cut_columns() const { return cut_columns_; }
+
+  // Column i's end from the target, along the target's normal (m; outside > 0).
+  double SurfaceDistance(int i) const;
+
   int columns() const { return static_cast<int>(radius_.size()); }
+  int rings() const { return rings_; }  // columns are ring-major: i = ring * segments + segment
+  int segments() const { return segments_; }
   const Eigen::Vector3d& direction(int i) const { return direction_[static_cast<std::size_t>(i)]; }
   double radius(int i) const { return radius_[static_cast<std::size_t>(i)]; }
   double target_radius(int i) const { return target_radius_[static_cast<std::size_t>(i)]; }
+  const Superellipsoid& target() const { return target_; }
   // Pose of the shape's centre frame in the map frame.
   const Eigen::Isometry3d& pose() const { return T_map_centre_; }
 
@@ -98,6 +112,8 @@ class Foliage {
   double NormalCosine(std::size_t i) const;
 
   Superellipsoid target_;
+  int rings_ = 0, segments_ = 0;
+  long cut_columns_ = 0;
   Eigen::Isometry3d T_map_centre_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> direction_;  // unit, in the centre frame
   std::vector<double> solid_angle_;         // sr per column

@@ -41,6 +41,8 @@ class RobotDescription {
   // The cutter blade's frame (the child of cutter_blade_joint: the disc about its z axis) in the
   // cutter frame (arm_end_effector), the blade at zero turn.
   Eigen::Isometry3d BladeInCutter() const;
+  // The blade disc's radius (m): its link's collision cylinder.
+  double BladeRadius() const;
   // Pose of a child link in its parent link for the joint at position q.
   static Eigen::Isometry3d JointTransform(const urdf::Joint& joint, double q);
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "trimbot/garden/conditions.h"
+#include "trimbot/garden/foliage.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/messages/commands.h"
 #include "trimbot/messages/sensor_messages.h"
@@ -58,6 +59,9 @@ struct SimulatorConfig {
   // exposed (what a camera-IMU calibration leaves; the stack assumes 0).
   double camera_time_offset = 0.0;
   std::vector<Fault> faults;  // injected at their times
+  // Topiaries (object ids) whose foliage the spinning cutter cuts: ground truth garden::Foliage,
+  // drawn as it is cut; their leaves give way and their wood collides (WorldOptions).
+  std::vector<int> cuttable_objects;
 };
 
 // What the robot's drivers deliver in one physics step.
@@ -184,6 +188,8 @@ class Simulator {
   // A view of the world now from outside the robot (RingRenderer::RenderExternalView).
   cv::Mat RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
                              int width, int height);
+  // The foliage of a cuttable topiary as cut so far (ground truth); nullptr for another object.
+  const garden::Foliage* foliage(int object_id) const;
   // What MuJoCo collides with for each garden object (meshes: their convex hulls), in the world frame.
   std::vector<CollisionHull> GardenCollisionHulls() const;
   // Every camera at the configured resolution (what the camera schedule renders).
@@ -200,6 +206,12 @@ class Simulator {
   // The weather the cameras see: plants moved by the wind, the sun dimmed by clouds.
   void SetUpWeather();
   void SetWeatherFor(double t);
+  // The cuttable topiaries: their foliage and drawn meshes.
+  void SetUpFoliage();
+  // The blade's sweep since the last step cuts the foliage (while the cutter spins).
+  void CutFoliage(const GroundTruth& truth);
+  // The drawn meshes of foliage cut since they were last drawn, as it is now.
+  void DrawCutFoliage();
   std::vector<ObstacleContact> ObstacleContacts() const;
   std::vector<ArmContact> ArmContacts() const;
   void ReadSensors(double stamp_before, SensorOutputs* sensors);

@@ -25,11 +25,18 @@ struct WorldOptions {
   int texture_size = 1024;        // px per texture tile
   double render_oversampling = 1.0;
   int msaa_samples = 4;  // multisample anti-aliasing; 0 renders twice as fast, with jagged edges
+  // Topiaries the cutter trims (object ids): their leaves give way (drawn, never collided with)
+  // and only their wood collides, the target shape kWoodDepth inside (not drawn).
+  std::vector<int> cuttable_objects;
   // Generated textures are kept here by (material, garden seed, size, generator version) and
   // copied into each world: every trial of a batch, and every test, uses the same few (seconds
   // to generate and encode). Empty: always generate.
   std::string texture_cache_dir = DefaultTextureCacheDir();
 };
+
+// How far inside a trimmed topiary's target its wood begins (m): deeper than the 2 cm a cut may
+// go into the target (van Marrewijk et al.'s tolerance), so a blade that keeps to it meets leaves only.
+inline constexpr double kWoodDepth = 0.03;
 
 struct WorldSpec {
   std::string mjcf_path;                  // world.xml written to disk (robot.xml beside it)

@@ -11,7 +11,8 @@
 //
 // Use:  RobotStack stack(files, parameters, seed);
 //       stack.SetInitialPose(0, believed_start);  stack.SetMap(map_yaml);  stack.SetGoals(goals);
-//       (a goal is a point, or Goal::ApproachBush: by map to ~1 m, then visual servoing)
+//       (a goal is a point, or Goal::ApproachBush: by map to ~1 m, then visual servoing, or
+//        Goal::TrimBush: approached so, then trimmed from the standoff)
 //       per sensor message: stack.Add(message);   then: commands = stack.Update(now);
 #include <Eigen/Core>
 #include <cstdint>
@@ -67,6 +68,10 @@ class RobotStack {
   // Cutter poses in base_link for the arm, reached in turn once the navigation goals (if any) are
   // done, while the base stands. The arm plans around what the ring's stereo pairs see then.
   void SetArmGoals(const std::vector<Eigen::Isometry3d>& cutter_poses);
+  // Stored cutting paths for trim goals (trimbot trim precompute): the nearest is adapted instead
+  // of solving the path in full. Throws InputError naming the file when it is not a cutting path
+  // database or was made for another arm.
+  void SetCuttingPathDatabase(const std::string& path);
   // Drive by hand: the command passes through to the base (navigation stays idle); the stack
   // still estimates its pose and runs perception.
   void SetTeleopCommand(const messages::BaseVelocityCommand& command);

@@ -14,6 +14,7 @@
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
 #include "trimbot/stack/obstacle_layer.h"
+#include "trimbot/trimming/trim_executive.h"
 #include "trimbot/visual_localization/features.h"
 
 namespace trimbot::stack {
@@ -78,7 +79,13 @@ struct StackParameters {
   ObstacleDetectionParameters obstacles;
   BushApproachParameters bush_approach;
   arm::ArmExecutiveParameters arm;  // arm goals: planning, the perceived environment, execution
+  // Trim goals: scan, fit, cutting path (its planner, speeds and settling are the arm's).
+  trimming::TrimParameters trim;
   VisualLocalizationParameters visual;
+
+  // The trim's parameters with the arm's planner, speeds and settling (one speed model for the
+  // arm's goals, the cutting path's costs and the stored paths of trimbot trim precompute).
+  trimming::TrimParameters Trim() const;
 
   // Some component uses the ring's images (the driver must deliver what RingRequestAt asks for).
   bool UsesRingImages() const {

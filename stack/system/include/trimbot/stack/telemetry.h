@@ -12,6 +12,7 @@
 #include "trimbot/perception/local_fusion.h"
 #include "trimbot/stack/ekf.h"
 #include "trimbot/stack/navigator.h"
+#include "trimbot/trimming/trim_executive.h"
 #include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::stack {
@@ -101,6 +102,18 @@ struct ArmStatus {
   std::vector<double> target;  // rad: the joint targets commanded now (empty when not moving)
 };
 
+// A trim under way (a trim goal's bush, approached).
+struct TrimStatus {
+  int goal = 0;      // index into the goals
+  std::string mode;  // TrimExecutive's mode
+};
+
+// A trim finished, for its goal.
+struct TrimResult {
+  int goal = 0;
+  trimming::TrimReport report;
+};
+
 // What the stack reports after an update, for logs and evaluation.
 struct Telemetry {
   double stamp = 0.0;
@@ -121,6 +134,8 @@ struct Telemetry {
   std::optional<BushApproachStatus> bush;       // while a bush goal is the current one
   std::optional<ArmStatus> arm;                 // with arm goals
   std::vector<arm::ArmGoalResult> arm_results;  // arm goals finished in the last update
+  std::optional<TrimStatus> trim;               // while a bush is trimmed
+  std::vector<TrimResult> trim_results;         // trims finished in the last update
   StackTimings timings;
 };
 

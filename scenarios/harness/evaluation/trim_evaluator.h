@@ -1,0 +1,66 @@
+#pragma once
+// The trim goals' ground-truth side. The simulator cuts each trim bush's foliage as the blade
+// sweeps it (sim::Simulator::foliage); this observer measures it against the bush's target shape
+// before the trial and after, times the cut, counts what the arm touched while trimming - MuJoCo's
+// contacts of the arm (the bush's wood, the ground, the robot itself) and any arm link other than
+// the blade reaching into the foliage (its collision cylinders against the foliage as cut so far) -
+// and sets the stack's fitted target (base_link, placed by the true base pose) against the true one.
+#include <Eigen/Geometry>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "evaluation/trial_result.h"
+#include "loop/closed_loop.h"
+#include "loop/scenario.h"
+#include "trimbot/garden/foliage.h"
+#include "trimbot/sim/simulator.h"
+
+namespace trimbot::scenarios {
+
+// The trim goals' bushes (object ids, each once): what the simulator makes cuttable.
+std::vector<int> TrimBushes(const Scenario& scenario);
+
+class TrimEvaluator : public Observer {
+ public:
+  // The simulator must have been made with TrimBushes(scenario) cuttable; it outlives the evaluator.
+  TrimEvaluator(const sim::Simulator& simulator, const Scenario& scenario);
+  void Observe(const StepView& step) override;
+  // The trims' outcomes (result->trims, trim_planning_seconds); a trim that failed fails the trial.
+  void Finish(TrialResult* result) const;
+  // Per trim bush: foliage_<id>_before.ply and _after.ply (the leaf surface with its signed
+  // distance to the target).
+  void WriteFiles(const std::string& dir) const;
+  // A trim bush's foliage as it was before the trial (the simulator has it as it is now).
+  const garden::Foliage& before(int bush) const;
+
+ private:
+  // An arm link's collision cylinder: its link, axis end points and radius in the link's frame.
+  struct LinkCylinder {
+    std::string link;
+    Eigen::Vector3d a, b;
+    double radius = 0.0;
+  };
+  struct Trim {
+    int goal = 0;
+    garden::Foliage before;
+    TrimOutcome outcome;
+    double started = -1.0;                                         // s: the stack's trim began (-1: not yet)
+    Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // true, when it began
+    double planning_seconds = -1.0;
+    bool touching = false;
+  };
+  // Whether an arm link other than the blade reaches into the foliage at the true joint positions.
+  bool LinksInFoliage(const sim::GroundTruth& truth, const garden::Foliage& foliage) const;
+  void Record(const stack::TrimResult& result, double now);
+
+  const sim::Simulator& simulator_;
+  std::vector<LinkCylinder> links_;
+  std::vector<Trim> trims_;
+  std::set<std::pair<std::string, std::string>> touching_;  // arm contacts in the last step
+  long steps_ = 0;
+};
+
+}  // namespace trimbot::scenarios

@@ -1,0 +1,148 @@
+#pragma once
+// Trimming one topiary from where the base stands (the arm's part of a `trim` goal):
+//
+//   Start(expected)        the bush as the survey and the servo place it, in base_link
+//     -> scan              one ring frame's stereo points (SetPerceivedPoints), from where the
+//                          approach ended (the whole bush in view)
+//     -> fit               the target shape into the points near the expected outline (FitTopiary)
+//     -> StandsAt(motion)  the base has moved closer (the arm must reach round the bush): the fit
+//                          is carried over by the base's motion
+//     -> plan              the cutting path over the fitted target: the nearest stored path
+//                          adapted (CuttingPathDatabase, when one is given and holds a target
+//                          near enough) or solved in full (PlanCuttingPath)
+//     -> cut               one joint trajectory through the path, the blade spinning; the moves
+//                          the path leaves to the planner are planned round the target
+//     -> done              the arm back at its start; report()
+//
+// The collision model's environment is the ground and the fitted target shrunk by the cut's
+// tolerance (MakeCuttingChecks): the leaves outside it are what the blade is there to cut. Nothing
+// here sees ground truth.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "trimbot/arm/arm_planner.h"
+#include "trimbot/messages/commands.h"
+#include "trimbot/messages/sensor_messages.h"
+#include "trimbot/perception/topiary_fit.h"
+#include "trimbot/robot/robot_description.h"
+#include "trimbot/trimming/cutting_path.h"
+#include "trimbot/trimming/plan_database.h"
+
+namespace trimbot::trimming {
+
+struct TrimParameters {
+  double surface_gap = 0.45;      // m from the surveyed outline to the arm's axis at the trim's standoff (the
+                                  // base advances there from the approach's on odometry)
+  double scan_margin = 0.25;      // m beyond the expected outline: stereo points this close are the bush's
+  double min_height = 0.05;       // m above the ground: lower points are grass
+  double max_point_sigma = 0.05;  // m: less certain stereo points are not used
+  int max_points = 5000;          // more are thinned evenly (the fit's time is linear in them)
+  perception::TopiaryFitOptions fit;
+  CuttingPoseOptions poses;
+  CuttingPathOptions path;
+  double tolerance = 0.02;              // m the blade may go into the fitted target
+  double blade_depth = 0.01;            // m inside the fitted surface the blade is aimed at (<= tolerance)
+  double database_max_distance = 0.15;  // m: a stored target farther than this is solved in full
+  arm::ArmPlannerParameters planner;    // the moves round the bush; its speeds time the whole cut
+  double settle_tolerance = 0.002;      // rad
+  double settle_timeout = 3.0;          // s
+};
+
+// How the trim went, as the stack knows it.
+struct TrimReport {
+  bool cut = false;               // the path was executed to its end
+  std::string failure;            // when not: why (no points, no fit, nothing reachable, no move round the bush)
+  double start = 0.0, end = 0.0;  // s: trim started, finished
+  int points = 0;                 // stereo points of the bush
+  std::optional<perception::TopiaryShape> fit;  // base_link
+  double fit_loss = 0.0;                        // m
+  int poses = 0, reached = 0;                   // blade poses on the target, and on the path
+  bool from_database = false;
+  double database_distance = 0.0;       // m to the stored target adapted
+  double planning_seconds = 0.0;        // wall clock: fit and path
+  double motion_time = 0.0;             // s: the path's rest-to-rest moves (the GTSP's cost)
+  double nearest_neighbour_time = 0.0;  // s: the greedy tour's, when solved in full
+  double cutting_duration = 0.0;        // s: the trajectory executed
+  int planned_moves = 0;                // moves planned round the target
+};
+
+class TrimExecutive {
+ public:
+  enum class Mode { kIdle, kWaitingForPoints, kFitted, kPlanning, kCutting, kSettling, kDone };
+
+  // `description` must outlive the executive. `database`, when given, is used for every trim.
+  TrimExecutive(const robot::RobotDescription& description, const TrimParameters& parameters);
+  ~TrimExecutive();
+  // Stored cutting paths (trimbot trim precompute). Throws InputError naming the file when it is
+  // not one or was made for another arm.
+  void SetDatabase(const std::string& path);
+
+  // Trims the bush expected as `expected` (base_link; its exponents are the plan's shape) with
+  // `tied` semi-axes; waits for a scan. `bush` names it among the bushes trimmed before (the same
+  // bush from another standoff: the fit takes its earlier scans too, placed by the pose estimate
+  // `T_map_base` now and at each scan). Without `cut`, done once fitted (a scan for later trims).
+  void Start(double stamp, const perception::TopiaryShape& expected, perception::AxesTied tied, int bush,
+             const Eigen::Isometry3d& T_map_base, bool cut = true);
+  bool WantsPoints() const { return mode_ == Mode::kWaitingForPoints && points_.empty(); }
+  // A scan of the surroundings in base_link (all pairs' stereo points).
+  void SetPerceivedPoints(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Matrix3d>& covariances);
+  // After the fit (kFitted): the base stands where it will cut from; `T_now_scan` is the scan's
+  // base_link in the current one.
+  void StandsAt(const Eigen::Isometry3d& T_now_scan);
+  void SetJointState(const messages::ArmJointState& joints);
+  // The arm's command now (none while idle, waiting or done).
+  std::optional<messages::ArmCommand> Update(double stamp);
+
+  Mode mode() const { return mode_; }
+  bool active() const { return mode_ != Mode::kIdle && mode_ != Mode::kDone; }
+  bool cutting() const { return mode_ == Mode::kCutting; }  // the blade spins
+  const TrimReport& report() const { return report_; }
+  const arm::JointTrajectory& trajectory() const { return trajectory_; }
+
+ private:
+  // The target from the scan; fails the trim with the reason when there is none.
+  void Fit(double stamp);
+  // The path from the measured joints over the target; the trajectory. Fails the trim with the
+  // reason when there is nothing to cut.
+  void Plan(double stamp);
+  void Finish(double stamp, const std::string& failure);
+  // The scan's stereo points within scan_margin of the expected target's surface, above the grass.
+  std::vector<Eigen::Vector3d> BushPoints() const;
+  // This scan's bush points and the bush's earlier scans (map frame), thinned, in base_link.
+  std::vector<Eigen::Vector3d> ScansOfTheBush();
+  // The joint path through the cutting path's configurations (planned moves round the target),
+  // continuous joints unwrapped from the start; empty with *failure set when a move cannot be planned.
+  std::vector<Eigen::VectorXd> Waypoints(const CuttingPath& path, std::string* failure);
+
+  TrimParameters parameters_;
+  arm::ArmKinematics kinematics_;
+  Eigen::Isometry3d T_cutter_blade_;
+  std::unique_ptr<robot::CollisionModel> collision_;
+  std::unique_ptr<arm::ArmPlanner> planner_;
+  std::optional<CuttingPathDatabase> database_;
+
+  Mode mode_ = Mode::kIdle;
+  perception::TopiaryShape expected_;
+  perception::AxesTied tied_ = perception::AxesTied::kNone;
+  int bush_ = 0;
+  bool cut_ = true;
+  Eigen::Isometry3d T_map_base_ = Eigen::Isometry3d::Identity();  // estimated, at the scan
+  std::map<int, std::vector<Eigen::Vector3d>> scans_;             // each bush's scans, map frame
+  perception::TopiaryShape target_shape_;                         // fitted, in the current base_link
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<Eigen::Matrix3d> covariances_;
+  std::optional<messages::ArmJointState> joints_;
+  arm::JointTrajectory trajectory_;
+  double motion_start_ = 0.0, settle_start_ = 0.0;
+  Eigen::VectorXd target_;
+  TrimReport report_;
+};
+
+const char* ToString(TrimExecutive::Mode mode);
+
+}  // namespace trimbot::trimming

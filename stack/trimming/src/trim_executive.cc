@@ -1,0 +1,239 @@
+#include "trimbot/trimming/trim_executive.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace trimbot::trimming {
+namespace {
+
+Eigen::VectorXd ToVector(const messages::ArmJointState& joints) {
+  return Eigen::Map<const Eigen::VectorXd>(joints.position.data(), static_cast<int>(joints.position.size()));
+}
+
+}  // namespace
+
+const char* ToString(TrimExecutive::Mode mode) {
+  switch (mode) {
+    case TrimExecutive::Mode::kIdle:
+      return "idle";
+    case TrimExecutive::Mode::kWaitingForPoints:
+      return "scanning";
+    case TrimExecutive::Mode::kFitted:
+      return "fitted";
+    case TrimExecutive::Mode::kPlanning:
+      return "planning";
+    case TrimExecutive::Mode::kCutting:
+      return "cutting";
+    case TrimExecutive::Mode::kSettling:
+      return "settling";
+    case TrimExecutive::Mode::kDone:
+      return "done";
+  }
+  return "?";
+}
+
+TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const TrimParameters& parameters)
+    : parameters_(parameters),
+      kinematics_(description),
+      T_cutter_blade_(description.BladeInCutter()),
+      collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
+      planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
+  // One speed model for the path's costs and the trajectory that executes it.
+  parameters_.path.velocity_scale = parameters.planner.velocity_scale;
+  parameters_.path.acceleration = parameters.planner.acceleration;
+  parameters_.path.ik = parameters.planner.ik;
+}
+
+TrimExecutive::~TrimExecutive() = default;
+
+void TrimExecutive::SetDatabase(const std::string& path) {
+  database_ = CuttingPathDatabase::Load(path, ArmSignature(kinematics_, T_cutter_blade_));
+}
+
+void TrimExecutive::Start(double stamp, const perception::TopiaryShape& expected, perception::AxesTied tied, int bush,
+                          const Eigen::Isometry3d& T_map_base, bool cut) {
+  cut_ = cut;
+  expected_ = expected;
+  tied_ = tied;
+  bush_ = bush;
+  T_map_base_ = T_map_base;
+  points_.clear();
+  covariances_.clear();
+  report_ = TrimReport();
+  report_.start = stamp;
+  kinematics_.PrepareDatabase(parameters_.path.ik);  // not inside the plan
+  mode_ = Mode::kWaitingForPoints;
+}
+
+void TrimExecutive::SetPerceivedPoints(const std::vector<Eigen::Vector3d>& points,
+                                       const std::vector<Eigen::Matrix3d>& covariances) {
+  points_ = points;
+  covariances_ = covariances;
+}
+
+void TrimExecutive::SetJointState(const messages::ArmJointState& joints) { joints_ = joints; }
+
+void TrimExecutive::StandsAt(const Eigen::Isometry3d& T_now_scan) {
+  if (mode_ != Mode::kFitted) return;
+  target_shape_.centre = T_now_scan * target_shape_.centre;
+  const Eigen::Vector3d x = T_now_scan.linear().col(0);
+  target_shape_.yaw += std::atan2(x.y(), x.x());
+  mode_ = Mode::kPlanning;
+}
+
+std::vector<Eigen::Vector3d> TrimExecutive::BushPoints() const {
+  const double max_variance = parameters_.max_point_sigma * parameters_.max_point_sigma;
+  std::vector<Eigen::Vector3d> bush;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    const Eigen::Vector3d& p = points_[i];
+    if (!p.allFinite() || p.z() < parameters_.min_height) continue;
+    if (i < covariances_.size() && covariances_[i].diagonal().maxCoeff() > max_variance) continue;
+    if (expected_.RadialDistance(p) > parameters_.scan_margin) continue;
+    bush.push_back(p);
+  }
+  return bush;
+}
+
+std::vector<Eigen::Vector3d> TrimExecutive::ScansOfTheBush() {
+  // This scan joins the bush's earlier ones in the map frame (by the pose estimate at each).
+  std::vector<Eigen::Vector3d>& scans = scans_[bush_];
+  for (const Eigen::Vector3d& p : BushPoints()) scans.push_back(T_map_base_ * p);
+  // Thinned evenly to max_points (the fit's time is linear in them), in base_link now.
+  const double stride = std::max(1.0, static_cast<double>(scans.size()) / parameters_.max_points);
+  const Eigen::Isometry3d T_base_map = T_map_base_.inverse();
+  std::vector<Eigen::Vector3d> points;
+  for (double k = 0.0; k < static_cast<double>(scans.size()); k += stride) {
+    points.push_back(T_base_map * scans[static_cast<std::size_t>(k)]);
+  }
+  return points;
+}
+
+std::optional<messages::ArmCommand> TrimExecutive::Update(double stamp) {
+  if (mode_ == Mode::kWaitingForPoints && !points_.empty()) Fit(stamp);
+  if (mode_ == Mode::kPlanning && joints_) Plan(stamp);
+  if (mode_ != Mode::kCutting && mode_ != Mode::kSettling) return std::nullopt;
+  if (mode_ == Mode::kCutting) {
+    Eigen::VectorXd velocity;
+    trajectory_.Sample(stamp - motion_start_, &target_, &velocity);
+    if (stamp - motion_start_ >= trajectory_.duration()) {
+      mode_ = Mode::kSettling;
+      settle_start_ = stamp;
+    }
+  } else {
+    const double off = (ToVector(*joints_) - target_).cwiseAbs().maxCoeff();
+    if (off <= parameters_.settle_tolerance) {
+      report_.cut = true;
+      Finish(stamp, "");
+      return std::nullopt;
+    }
+    if (stamp - settle_start_ > parameters_.settle_timeout) {
+      std::ostringstream why;
+      why << "the arm did not settle at its start within " << parameters_.settle_timeout << " s: a joint is " << off
+          << " rad off";
+      Finish(stamp, why.str());
+      return std::nullopt;
+    }
+  }
+  messages::ArmCommand command;
+  command.mode = messages::ArmCommand::Mode::kPosition;
+  for (int i = 0; i < target_.size(); ++i) command.position[static_cast<std::size_t>(i)] = target_(i);
+  return command;
+}
+
+void TrimExecutive::Fit(double stamp) {
+  const auto begin = std::chrono::steady_clock::now();
+  const std::vector<Eigen::Vector3d> bush = ScansOfTheBush();
+  report_.points = static_cast<int>(bush.size());
+  std::string failure;
+  const std::optional<perception::TopiaryFit> fit = FitTopiary(bush, expected_, tied_, parameters_.fit, &failure);
+  if (!fit) {
+    Finish(stamp, "no target shape from the scan: " + failure);
+    return;
+  }
+  report_.fit = fit->shape;
+  target_shape_ = fit->shape;
+  report_.fit_loss = fit->loss;
+  report_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  mode_ = Mode::kFitted;
+  if (!cut_) Finish(stamp, "");  // a scan only
+}
+
+void TrimExecutive::Plan(double stamp) {
+  const auto begin = std::chrono::steady_clock::now();
+  const perception::TopiaryShape& target = target_shape_;
+  std::string failure;
+  const CuttingChecks checks = MakeCuttingChecks(kinematics_, collision_.get(), target, parameters_.tolerance,
+                                                 parameters_.planner.collision_step);
+  planner_->ResetRoadmap();
+  // Where the blade goes: the fitted surface, or blade_depth inside it.
+  perception::TopiaryShape blade_surface = target;
+  blade_surface.half -= Eigen::Vector3d::Constant(parameters_.blade_depth);
+  const Eigen::VectorXd start = ToVector(*joints_);
+  CuttingPath path;
+  double distance = 0.0;
+  const StoredCuttingPath* stored = database_ ? database_->Nearest(target, &distance) : nullptr;
+  if (stored != nullptr && distance <= parameters_.database_max_distance) {
+    path = AdaptCuttingPath(kinematics_, T_cutter_blade_, start, *stored, blade_surface, checks.valid, checks.free_move,
+                            parameters_.path);
+    report_.from_database = path.ok;
+    report_.database_distance = distance;
+    report_.poses = static_cast<int>(stored->blades.size());
+  }
+  if (!path.ok) {
+    const std::vector<Eigen::Isometry3d> poses = CuttingPoses(blade_surface, parameters_.poses);
+    report_.poses = static_cast<int>(poses.size());
+    path =
+        PlanCuttingPath(kinematics_, T_cutter_blade_, start, poses, checks.valid, checks.free_move, parameters_.path);
+    report_.nearest_neighbour_time = path.nearest_neighbour_time;
+  }
+  if (!path.ok) {
+    Finish(stamp, "no cutting path: " + path.failure);
+    return;
+  }
+  report_.reached = static_cast<int>(path.poses.size());
+  report_.motion_time = path.motion_time;
+  const std::vector<Eigen::VectorXd> waypoints = Waypoints(path, &failure);
+  report_.planning_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (waypoints.empty()) {
+    Finish(stamp, failure);
+    return;
+  }
+  Eigen::VectorXd limits(kinematics_.joints());
+  for (int i = 0; i < kinematics_.joints(); ++i) {
+    limits(i) = parameters_.planner.velocity_scale * kinematics_.limits()[static_cast<std::size_t>(i)].velocity;
+  }
+  trajectory_ = arm::TimeParameterize(waypoints, limits, parameters_.planner.acceleration);
+  report_.cutting_duration = trajectory_.duration();
+  motion_start_ = stamp;
+  target_ = trajectory_.positions.front();
+  mode_ = Mode::kCutting;
+}
+
+std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, std::string* failure) {
+  std::vector<Eigen::VectorXd> waypoints{path.configurations.front()};
+  for (std::size_t i = 0; i + 1 < path.configurations.size(); ++i) {
+    const Eigen::VectorXd from = waypoints.back();
+    const Eigen::VectorXd to = from + kinematics_.JointDifference(from, path.configurations[i + 1]);
+    if (!path.planned[i]) {
+      waypoints.push_back(to);
+      continue;
+    }
+    const arm::ArmPlan plan = planner_->PlanToJoints(from, to);
+    if (!plan.ok) {
+      *failure = "no move round the target from blade pose " + std::to_string(i) + " to the next: " + plan.failure;
+      return {};
+    }
+    waypoints.insert(waypoints.end(), plan.waypoints.begin() + 1, plan.waypoints.end());
+    ++report_.planned_moves;
+  }
+  return waypoints;
+}
+
+void TrimExecutive::Finish(double stamp, const std::string& failure) {
+  report_.failure = failure;
+  report_.end = stamp;
+  mode_ = Mode::kDone;
+}
+
+}  // namespace trimbot::trimming
