@@ -338,6 +338,7 @@ TEST(TrimExecutive, FailsWithTheReasonOnAnEmptyScanOrABushOutOfReach) {
     EXPECT_FALSE(trim.report().cut);
     const std::string why = empty ? "no target shape from the scan" : "no cutting path";
     EXPECT_NE(trim.report().failure.find(why), std::string::npos) << trim.report().failure;
+    if (!empty) EXPECT_EQ(trim.report().path_source, "solved in full: no stored paths given");
   }
 }
 

@@ -115,6 +115,7 @@ struct TrimOutcome {
   int points = 0;                           // stereo points of the bush the fit used
   int poses = 0, reached_poses = 0;         // blade poses on the fitted target, and on the path
   bool from_database = false;               // the path adapted from a stored one
+  std::string path_source;                  // the stack's words: adapted, or solved in full and why
   double motion_seconds = 0.0;              // the path's move times (the GTSP's cost)
   double nearest_neighbour_seconds = 0.0;   // the greedy tour's (solved in full only)
   double fit_centre_error_m = -1.0;         // the fitted centre from the true one (-1: no fit)
@@ -126,8 +127,8 @@ struct TrimOutcome {
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after,
                                    overcut_share, overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
-                                   trim_seconds, points, poses, reached_poses, from_database, motion_seconds,
-                                   nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m,
+                                   trim_seconds, points, poses, reached_poses, from_database, path_source,
+                                   motion_seconds, nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m,
                                    fit_centre_offset_m, fit_half_m, arm_contacts, foliage_touches)
 
 struct TrialResult {

@@ -113,6 +113,7 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.poses = report.poses;
   o.reached_poses = report.reached;
   o.from_database = report.from_database;
+  o.path_source = report.path_source;
   o.motion_seconds = report.motion_time;
   o.nearest_neighbour_seconds = report.nearest_neighbour_time;
   trim->planning_seconds = report.planning_seconds;

@@ -173,13 +173,24 @@ void TrimExecutive::Plan(double stamp) {
   CuttingPath path;
   double distance = 0.0;
   const StoredCuttingPath* stored = database_ ? database_->Nearest(target, &distance) : nullptr;
-  if (stored != nullptr && distance <= parameters_.database_max_distance) {
+  std::ostringstream source;
+  if (!database_) {
+    source << "solved in full: no stored paths given";
+  } else if (stored == nullptr) {
+    source << "solved in full: no stored path of this shape";
+  } else if (distance > parameters_.database_max_distance) {
+    source << "solved in full: the nearest stored target is " << distance << " m off (more than "
+           << parameters_.database_max_distance << " m)";
+  } else {
     path = AdaptCuttingPath(kinematics_, T_cutter_blade_, start, *stored, blade_surface, checks.valid, checks.free_move,
                             parameters_.path);
     report_.from_database = path.ok;
-    report_.database_distance = distance;
     report_.poses = static_cast<int>(stored->blades.size());
+    source << (path.ok ? "stored path adapted" : "solved in full: no pose of the stored path fits");
+    source << " (stored target " << distance << " m off)";
   }
+  report_.database_distance = stored != nullptr ? distance : -1.0;
+  report_.path_source = source.str();
   if (!path.ok) {
     const std::vector<Eigen::Isometry3d> poses = CuttingPoses(blade_surface, parameters_.poses);
     report_.poses = static_cast<int>(poses.size());

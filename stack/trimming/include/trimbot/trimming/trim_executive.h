@@ -63,7 +63,8 @@ struct TrimReport {
   double fit_loss = 0.0;                        // m
   int poses = 0, reached = 0;                   // blade poses on the target, and on the path
   bool from_database = false;
-  double database_distance = 0.0;       // m to the stored target adapted
+  double database_distance = -1.0;      // m to the nearest stored target of the shape (-1: none)
+  std::string path_source;              // adapted, or solved in full and why
   double planning_seconds = 0.0;        // wall clock: fit and path
   double motion_time = 0.0;             // s: the path's rest-to-rest moves (the GTSP's cost)
   double nearest_neighbour_time = 0.0;  // s: the greedy tour's, when solved in full
