@@ -138,15 +138,9 @@ ArmReachEvaluator::ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachP
 void ArmReachEvaluator::Observe(const StepView& step) {
   const sim::GroundTruth& truth = step.truth;
   const bool working = current_ < static_cast<int>(outcomes_.size());
-  // Contact events: an arm geom touching something it did not touch in the step before.
-  std::set<std::pair<std::string, std::string>> touching;
-  for (const sim::ArmContact& contact : truth.arm_contacts) touching.insert({contact.arm_geom, contact.other_geom});
-  for (const auto& pair : touching) {
-    if (touching_.count(pair)) continue;
-    ++contacts_;
-    if (working) ++outcomes_[static_cast<size_t>(current_)].contacts;
-  }
-  touching_ = std::move(touching);
+  const int events = contact_events_.Update(truth.arm_contacts);
+  contacts_ += events;
+  if (working) outcomes_[static_cast<size_t>(current_)].contacts += events;
 
   const Eigen::VectorXd q = JointVector(truth.arm_position);
   const stack::Telemetry* telemetry = step.telemetry;

@@ -9,10 +9,10 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
-#include <set>
 #include <string>
 #include <vector>
 
+#include "evaluation/contact_events.h"
 #include "evaluation/trial_result.h"
 #include "loop/closed_loop.h"
 #include "loop/scenario.h"
@@ -64,7 +64,7 @@ class ArmReachEvaluator : public Observer {
   ArmCollisionTruth* truth_;
   std::function<void(int)> on_reached_;
   std::vector<ArmGoalOutcome> outcomes_;
-  std::set<std::pair<std::string, std::string>> touching_;  // arm contacts in the last step
+  ContactEvents contact_events_;
   int contacts_ = 0;
   int current_ = 0;  // the goal the stack works on
   long steps_ = 0;

@@ -74,7 +74,7 @@ void TrimEvaluator::Observe(const StepView& step) {
   if (telemetry == nullptr) return;
   for (const stack::TrimResult& result : telemetry->trim_results) Record(result, step.time);
   if (!telemetry->trim) {
-    touching_.clear();
+    contact_events_.Clear();
     return;
   }
   const auto trim =
@@ -88,13 +88,7 @@ void TrimEvaluator::Observe(const StepView& step) {
   if (telemetry->trim->mode == trimming::ToString(trimming::TrimExecutive::Mode::kCutting)) {
     trim->outcome.cutting_seconds += step.timestep;
   }
-  std::set<std::pair<std::string, std::string>> touching;
-  for (const sim::ArmContact& contact : step.truth.arm_contacts) {
-    const auto pair = std::make_pair(contact.arm_geom, contact.other_geom);
-    touching.insert(pair);
-    if (!touching_.count(pair)) ++trim->outcome.arm_contacts;
-  }
-  touching_ = std::move(touching);
+  trim->outcome.arm_contacts += contact_events_.Update(step.truth.arm_contacts);
   if (steps_ % kTouchEvery != 0) return;
   const bool in_foliage = LinksInFoliage(step.truth, *simulator_.foliage(trim->outcome.bush));
   if (in_foliage && !trim->touching) ++trim->outcome.foliage_touches;

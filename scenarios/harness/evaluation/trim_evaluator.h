@@ -7,11 +7,11 @@
 // and sets the stack's fitted target (base_link, placed by the true base pose) against the true one.
 #include <Eigen/Geometry>
 #include <optional>
-#include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "evaluation/contact_events.h"
 #include "evaluation/trial_result.h"
 #include "loop/closed_loop.h"
 #include "loop/scenario.h"
@@ -59,7 +59,7 @@ class TrimEvaluator : public Observer {
   const sim::Simulator& simulator_;
   std::vector<LinkCylinder> links_;
   std::vector<Trim> trims_;
-  std::set<std::pair<std::string, std::string>> touching_;  // arm contacts in the last step
+  ContactEvents contact_events_;  // MuJoCo's arm contacts
   long steps_ = 0;
 };
 
