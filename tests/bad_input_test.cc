@@ -46,7 +46,7 @@ start: {x: 0.0, y: 0.0, yaw_deg: 10.0}
 goals:
   - {x: 4.0, y: 0.0}
   - {approach_bush: 1}
-  - {trim_bush: 2}
+  - {trim_bush: 2, side_deg: 90.0}
 cutting_path_database: paths.sqlite
 goal_tolerance: 0.3
 bush_tolerance: {distance: 0.1, bearing_deg: 5.0}

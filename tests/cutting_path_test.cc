@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <string>
 
 #include "test_support.h"
 #include "trimbot/common/atomic_file.h"
@@ -340,6 +342,101 @@ TEST(TrimExecutive, FailsWithTheReasonOnAnEmptyScanOrABushOutOfReach) {
     EXPECT_NE(trim.report().failure.find(why), std::string::npos) << trim.report().failure;
     if (!empty) EXPECT_EQ(trim.report().path_source, "solved in full: no stored paths given");
   }
+}
+
+// Whether an arm link other than the blade (the URDF's collision cylinders of links 1-6, the
+// cutter's housing included) comes within `margin` of the leaves, the base at the origin.
+bool LinksInLeaves(const robot::RobotDescription& robot, const garden::Foliage& foliage, const Eigen::VectorXd& q,
+                   double margin = 0.0) {
+  std::map<std::string, double> joints;
+  const std::vector<std::string> names = robot.ArmJointNames();
+  for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = q(static_cast<int>(i));
+  for (const std::string& joint : names) {
+    const auto link = robot.urdf().getLink(robot.urdf().getJoint(joint)->child_link_name);
+    const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get());
+    const Eigen::Isometry3d T = robot.FramePose(link->name, joints) * robot::ToIsometry(link->collision->origin);
+    const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
+    if (foliage.ReachesCylinder(T * -half, T * half, cylinder->radius + margin)) return true;
+  }
+  return false;
+}
+
+// The arm comes in to the cut and leaves it round the leaves the scan saw, then along the blade's
+// axis: the trajectory run with the blade cutting the bush's true leaves as it sweeps (as the
+// simulator does), no link but the blade reaches into them on the way in or out, nor within 2 cm
+// of them while the blade is clear of them (stereo's noise at the standoff, the leaves' sway).
+TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  const arm::ArmKinematics kinematics(robot);
+  const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
+  garden::GardenObject bush;
+  bush.id = 1;
+  bush.object_class = garden::ObjectClass::kTopiary;
+  bush.shape = garden::Shape::kEllipsoid;
+  bush.size = {0.6, 0.6, 0.6};
+  bush.position = {0.95, 0.0};
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.35);  // a bush due for trimming
+  Rng rng = MakeRng(5, "leaves");
+  const std::vector<Eigen::Vector3d> seen =
+      LeavesSeenFrom(foliage, Eigen::Isometry3d::Identity(), -Eigen::Vector3d::UnitX(), rng);
+  TrimParameters parameters;  // a coarse path, for the test's time
+  parameters.poses.spacing = 0.15;
+  parameters.path.rolls = 2;
+  parameters.path.search.restarts = 1;
+  parameters.path.search.warm_restarts = 0;
+  TrimExecutive trim(robot, parameters);
+  messages::ArmJointState joints;
+  joints.position = robot_parameters.arm_home_position;
+  trim.SetJointState(joints);
+  perception::TopiaryShape expected;
+  expected.centre = foliage.pose().translation();
+  expected.half = Eigen::Vector3d::Constant(0.3);
+  trim.Start(0.0, expected, perception::AxesTied::kAll, 1, Eigen::Isometry3d::Identity());
+  trim.SetPerceivedPoints(seen, {});
+  trim.Update(0.1);
+  ASSERT_EQ(trim.mode(), TrimExecutive::Mode::kFitted) << trim.report().failure;
+  trim.StandsAt(Eigen::Isometry3d::Identity());
+  trim.Update(0.2);
+  ASSERT_EQ(trim.mode(), TrimExecutive::Mode::kCutting) << trim.report().failure;
+  EXPECT_EQ(trim.report().moves_round_the_leaves, 2);
+  EXPECT_GT(trim.report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.35";
+  ASSERT_LT(trim.cut_begins(), trim.cut_ends());
+  const arm::JointTrajectory& trajectory = trim.trajectory();
+  const auto sample = [&](double t) {
+    Eigen::VectorXd q, velocity;
+    trajectory.Sample(t, &q, &velocity);
+    const Eigen::Isometry3d blade = kinematics.EndEffectorPose(q) * robot.BladeInCutter();
+    garden::BladeDisc disc;
+    disc.centre = blade.translation();
+    disc.axis = blade.linear().col(2);
+    disc.radius = 0.05;
+    return std::make_pair(q, disc);
+  };
+  std::map<std::string, int> touches, near;  // link touch events, and samples within 2 cm, by stage
+  bool touching = false;
+  garden::BladeDisc last = sample(0.0).second;
+  for (double t = 0.02; t <= trajectory.duration(); t += 0.02) {  // the blade 1 cm at most (swept in between)
+    const auto [q, disc] = sample(t);
+    foliage.Cut(last, disc);
+    last = disc;
+    const bool in = LinksInLeaves(robot, foliage, q);
+    const std::string stage = t < trim.cut_begins() ? "moving in" : t > trim.cut_ends() ? "moving out" : "cutting";
+    if (in && !touching) ++touches[stage];
+    touching = in;
+    const Eigen::Vector3d thickness = 0.002 * disc.axis;
+    if (stage != "cutting" && !foliage.ReachesCylinder(disc.centre - thickness, disc.centre + thickness, disc.radius)) {
+      near[stage] += LinksInLeaves(robot, foliage, q, 0.02) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(touches["moving in"], 0);
+  EXPECT_EQ(touches["moving out"], 0);
+  EXPECT_EQ(near["moving in"], 0);
+  EXPECT_EQ(near["moving out"], 0);
+  std::printf(
+      "round the leaves seen %.1f cm deep: link touches moving in %d, cutting %d, moving out %d; within 2 cm of "
+      "the leaves, the blade clear: moving in %d, moving out %d samples\n",
+      100.0 * trim.report().leaf_depth, touches["moving in"], touches["cutting"], touches["moving out"],
+      near["moving in"], near["moving out"]);
 }
 
 }  // namespace

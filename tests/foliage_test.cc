@@ -2,6 +2,7 @@
 // foliage beyond where it crossed each column, and the cut is measured against the target.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -124,6 +125,37 @@ TEST(Foliage, GrowthLowersTheShareOfTheSurfaceNearTheTarget) {
     EXPECT_LT(grown.surface_within_tolerance, 0.5 * trimmed.surface_within_tolerance);
     EXPECT_GT(grown.max_overgrowth, 0.4 * 0.5 * 0.15);
   }
+}
+
+TEST(Foliage, AHousingBehindABladeThatCutItsWayInIsClearOfTheLeavesBesideItIsNot) {
+  const GardenObject bush = Topiary(Shape::kEllipsoid, {0.7, 0.7, 0.7});
+  Foliage foliage = Foliage::Grown(bush, 4, 0.5);
+  // The blade (0.05 m radius) pushed in along -x from outside to the target's surface on the +x
+  // side, then its housing (the last link's 0.03 m cylinder, 1 cm behind the disc, 0.13 m long).
+  const Eigen::Vector3d out = foliage.pose().linear() * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d surface = foliage.pose() * Eigen::Vector3d(0.35, 0.0, 0.0);
+  BladeDisc from, to;
+  from.centre = surface + 0.2 * out;
+  to.centre = surface;
+  from.axis = to.axis = out;
+  from.radius = to.radius = 0.05;
+  const Eigen::Vector3d a = surface + 0.01 * out, b = a + 0.13 * out;
+  EXPECT_TRUE(foliage.ReachesCylinder(a, b, 0.03)) << "the leaves stand there before the cut";
+  foliage.Cut(from, to);
+  EXPECT_FALSE(foliage.ReachesCylinder(a, b, 0.03));
+  // The same housing 0.1 m to the side, beyond the blade's swept disc: in uncut leaves.
+  const Eigen::Vector3d side = foliage.pose().linear() * Eigen::Vector3d(0.0, 0.1, 0.0);
+  EXPECT_TRUE(foliage.ReachesCylinder(a + side, b + side, 0.03));
+  // Only its mantle reaches in when it lies along the surface just outside the leaves' tips.
+  const Eigen::Vector3d tip =
+      foliage.pose() * (foliage.RadiusAlong(Eigen::Vector3d::UnitZ()) * Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d up = foliage.pose().linear() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d along = foliage.pose().linear() * Eigen::Vector3d(0.0, 0.06, 0.0);
+  EXPECT_TRUE(foliage.ReachesCylinder(tip + 0.02 * up - along, tip + 0.02 * up + along, 0.03));
+  double top = 0.0;  // m above the centre: the highest leaf
+  for (int i = 0; i < foliage.columns(); ++i) top = std::max(top, foliage.radius(i) * foliage.direction(i).z());
+  const Eigen::Vector3d above = foliage.pose() * Eigen::Vector3d(0.0, 0.0, top + 0.04);
+  EXPECT_FALSE(foliage.ReachesCylinder(above - along, above + along, 0.03)) << "1 cm above the highest leaf";
 }
 
 TEST(Foliage, WritesItsSurfaceAsPly) {

@@ -11,6 +11,7 @@
 #include "trimbot/garden/object_mesh.h"
 #include "trimbot/garden/textures.h"
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
@@ -230,6 +231,38 @@ TEST(GardenGenerator, SameSeedSameGardenOtherSeedAnother) {
   // The written file loads back to the same garden.
   const Garden reloaded = Garden::Load(WriteTempFile("generated.yaml", a.ToYaml()));
   EXPECT_EQ(reloaded.ToYaml(), a.ToYaml());
+}
+
+TEST(GardenGenerator, ShapesTopiaryInTheSharesAskedFor) {
+  GeneratorParameters parameters;
+  parameters.seed = 11;
+  parameters.size = {30.0, 30.0};
+  parameters.topiary = 60;
+  std::map<Shape, int> count;
+  for (const auto& object : GenerateGarden(parameters).objects) {
+    if (object.object_class == ObjectClass::kTopiary) ++count[object.shape];
+  }
+  EXPECT_EQ(count[Shape::kCylinder], 0) << "the default draws boxes and ellipsoids only";
+  EXPECT_GT(count[Shape::kBox], 6);
+  parameters.topiary_box_share = 0.2;
+  parameters.topiary_cylinder_share = 0.5;
+  count.clear();
+  int topiary = 0;
+  for (const auto& object : GenerateGarden(parameters).objects) {
+    if (object.object_class != ObjectClass::kTopiary) continue;
+    ++topiary;
+    ++count[object.shape];
+    if (object.shape == Shape::kCylinder) {
+      EXPECT_EQ(object.size.x(), object.size.y()) << "a round plan";
+    }
+  }
+  // Binomial: 3 standard deviations round the shares' expectation.
+  const auto near = [topiary](int n, double share) {
+    return std::abs(n - share * topiary) <= 3.0 * std::sqrt(topiary * share * (1.0 - share));
+  };
+  EXPECT_GT(topiary, 40);
+  EXPECT_TRUE(near(count[Shape::kBox], 0.2)) << count[Shape::kBox] << " of " << topiary;
+  EXPECT_TRUE(near(count[Shape::kCylinder], 0.5)) << count[Shape::kCylinder] << " of " << topiary;
 }
 
 TEST(GardenGenerator, KeepsRoomForTheRobotBetweenObjects) {

@@ -346,12 +346,14 @@ TEST(Scenario, TrimBushNeedsATopiaryAndTheDatabaseATrim) {
       EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
     }
   }
-  const Scenario ok =
-      Scenario::Load(SmokeVariant("trim_ok.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{trim_bush: 1}"));
+  const Scenario ok = Scenario::Load(
+      SmokeVariant("trim_ok.yaml", "\\{x: 4.0, y: 0.0, yaw_deg: 90.0\\}", "{trim_bush: 1, side_deg: 90.0}"));
   const PreparedTrial prepared = PrepareTrial(ok, ProjectPaths{TRIMBOT_SOURCE_DIR});
   ASSERT_EQ(prepared.mission.size(), 1u);
   EXPECT_TRUE(prepared.mission[0].trim);
   EXPECT_TRUE(prepared.mission[0].bush.has_value());
+  ASSERT_TRUE(prepared.mission[0].side.has_value());
+  EXPECT_DOUBLE_EQ(*prepared.mission[0].side, M_PI / 2.0);
 }
 
 // A goal that some headings cannot arrive at (the footprint would touch a rose on the last

@@ -197,10 +197,35 @@ double Foliage::RadiusAlong(const Eigen::Vector3d& direction) const {
   return radius_[static_cast<std::size_t>(r * segments_ + s)];
 }
 
-bool Foliage::Reaches(const Eigen::Vector3d& point, double margin) const {
+bool Foliage::Reaches(const Eigen::Vector3d& point) const {
   const Eigen::Vector3d p = T_map_centre_.inverse() * point;
   const double distance = p.norm();
-  return distance < 1e-9 || distance <= RadiusAlong(p / distance) + margin;
+  return distance < 1e-9 || distance <= RadiusAlong(p / distance);
+}
+
+bool Foliage::ReachesCylinder(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const {
+  constexpr double kStep = 0.01;  // m, about a leaf
+  const Eigen::Vector3d axis = b - a;
+  const double length = axis.norm();
+  const Eigen::Vector3d z = length > 1e-9 ? Eigen::Vector3d(axis / length) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d x = z.unitOrthogonal(), y = z.cross(x);
+  const int along = std::max(1, static_cast<int>(std::ceil(length / kStep)));
+  const int round = std::max(6, static_cast<int>(std::ceil(2.0 * M_PI * radius / kStep)));
+  const int across = std::max(1, static_cast<int>(std::ceil(radius / kStep)));
+  for (int i = 0; i <= along; ++i) {
+    const Eigen::Vector3d c = a + axis * (static_cast<double>(i) / along);
+    if (Reaches(c)) return true;
+    // The mantle at every step; the caps' discs at the two ends.
+    const int rings = i == 0 || i == along ? across : 1;
+    for (int ring = 1; ring <= rings; ++ring) {
+      const double r = radius * (rings == 1 ? 1.0 : static_cast<double>(ring) / rings);
+      for (int k = 0; k < round; ++k) {
+        const double angle = 2.0 * M_PI * k / round;
+        if (Reaches(c + r * (std::cos(angle) * x + std::sin(angle) * y))) return true;
+      }
+    }
+  }
+  return false;
 }
 
 void Foliage::Cut(const BladeDisc& from, const BladeDisc& to) {

@@ -195,9 +195,13 @@ class GardenGenerator {
     for (int i = 0; i < p_.corridors; ++i) AddCorridor();
     for (int i = 0; i < p_.topiary; ++i) {
       const double d = uniform(0.6, 0.9);
-      Place(Make(ObjectClass::kTopiary, UniformUnit(rng_) < 0.3 ? Shape::kBox : Shape::kEllipsoid,
-                 {d, d * uniform(0.9, 1.1), d * uniform(0.6, 1.0)}),
-            p_.robot_clearance);
+      const double u = UniformUnit(rng_);
+      const Shape shape = u < p_.topiary_box_share                               ? Shape::kBox
+                          : u < p_.topiary_box_share + p_.topiary_cylinder_share ? Shape::kCylinder
+                                                                                 : Shape::kEllipsoid;
+      // A cylinder's plan is round (the foliage and the fit take its x and y as one diameter).
+      const double across = shape == Shape::kCylinder ? d : d * uniform(0.9, 1.1);
+      Place(Make(ObjectClass::kTopiary, shape, {d, across, d * uniform(0.6, 1.0)}), p_.robot_clearance);
     }
     for (int i = 0; i < p_.roses; ++i) {
       const double d = uniform(0.5, 0.8);
@@ -257,12 +261,15 @@ class GardenGenerator {
     return o;
   }
 
-  // Places an object where it overlaps nothing else, with the robot's clearance; gives up after
-  // a number of tries (a crowded garden just gets fewer objects).
+  // Places an object where it overlaps nothing else, with the robot's clearance, and fence_clearance
+  // inside the edge; gives up after a number of tries, or at once when the garden is too small for
+  // it (a crowded garden just gets fewer objects).
   GardenObject* Place(GardenObject object, double margin) {
+    const double edge = p_.fence_clearance;
+    if ((object.size.head<2>() / 2 + Eigen::Vector2d::Constant(edge) - half_).maxCoeff() > 0.0) return nullptr;
     for (int attempt = 0; attempt < 200; ++attempt) {
-      object.position = {uniform(-half_.x() + object.size.x() / 2 + 0.5, half_.x() - object.size.x() / 2 - 0.5),
-                         uniform(-half_.y() + object.size.y() / 2 + 0.5, half_.y() - object.size.y() / 2 - 0.5)};
+      object.position = {uniform(-half_.x() + object.size.x() / 2 + edge, half_.x() - object.size.x() / 2 - edge),
+                         uniform(-half_.y() + object.size.y() / 2 + edge, half_.y() - object.size.y() / 2 - edge)};
       bool free = true;
       for (const auto& other : garden_.objects) {
         if (other.object_class == ObjectClass::kFence) continue;

@@ -44,6 +44,10 @@ void AddGardenCommands(Commands& commands) {
   generate_cmd->add_option("--seed", g.seed, "seed (the same seed gives the same garden)")->required();
   generate_cmd->add_option("--size", options->size, "extent WxH in metres, e.g. 16x12");
   generate_cmd->add_option("--topiary", g.topiary, "number of topiary bushes")->check(CLI::Range(0, 1000));
+  generate_cmd->add_option("--box-share", g.topiary_box_share, "share of the topiary shaped as boxes")
+      ->check(CLI::Range(0.0, 1.0));
+  generate_cmd->add_option("--cylinder-share", g.topiary_cylinder_share, "share of the topiary shaped as cylinders")
+      ->check(CLI::Range(0.0, 1.0));
   generate_cmd->add_option("--roses", g.roses, "number of rose bushes")->check(CLI::Range(0, 1000));
   generate_cmd->add_option("--hedges", g.hedges, "number of hedges")->check(CLI::Range(0, 1000));
   generate_cmd->add_option("--trees", g.trees, "number of trees")->check(CLI::Range(0, 1000));
@@ -55,12 +59,12 @@ void AddGardenCommands(Commands& commands) {
       ->check(CLI::Range(0, 100));
   generate_cmd->add_option("--clearance", g.robot_clearance, "free space kept between objects (m)")
       ->check(CLI::Range(0.0, 10.0));
+  generate_cmd->add_option("--fence-clearance", g.fence_clearance, "free space kept between objects and the edge (m)")
+      ->check(CLI::Range(0.0, 10.0));
   generate_cmd->add_option("--out", options->output, "garden YAML (default: standard output)");
   commands.OnRun(generate_cmd, [options] {
     options->generator.size = ParseGardenSize(options->size);
-    return GenerateGardenFile(options->generator,
-                              "--seed " + std::to_string(options->generator.seed) + " --size " + options->size,
-                              options->output);
+    return GenerateGardenFile(options->generator, options->output);
   });
 
   auto* export_cmd = garden_cmd->add_subcommand("export", "write the occupancy map (map_server) and ground-truth PLY");

@@ -122,14 +122,18 @@ struct TrimOutcome {
   double fit_axes_error_max_m = -1.0;       // the largest semi-axis error
   std::vector<double> fit_centre_offset_m;  // fitted - true centre, map frame (x, y, z; empty: no fit)
   std::vector<double> fit_half_m;           // the fitted semi-axes
+  double leaf_depth_m = 0.0;                // the leaves outside the fit as the stack saw them
+  int moves_round_the_leaves = 0;           // of the arm's moves in and out (2), round the seen leaves
   int arm_contacts = 0;                     // contact events of the arm (MuJoCo: the wood, the ground, itself)
   int foliage_touches = 0;                  // events of an arm link other than the blade reaching into the foliage
+  std::map<std::string, int> foliage_touches_by;  // the same by "<link> while <the trim's stage>"
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after,
                                    overcut_share, overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
                                    trim_seconds, points, poses, reached_poses, from_database, path_source,
                                    motion_seconds, nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m,
-                                   fit_centre_offset_m, fit_half_m, arm_contacts, foliage_touches)
+                                   fit_centre_offset_m, fit_half_m, leaf_depth_m, moves_round_the_leaves, arm_contacts,
+                                   foliage_touches, foliage_touches_by)
 
 struct TrialResult {
   int index = 0;

@@ -52,20 +52,18 @@ TrimEvaluator::TrimEvaluator(const sim::Simulator& simulator, const Scenario& sc
   }
 }
 
-bool TrimEvaluator::LinksInFoliage(const sim::GroundTruth& truth, const garden::Foliage& foliage) const {
+std::string TrimEvaluator::LinkInFoliage(const sim::GroundTruth& truth, const garden::Foliage& foliage) const {
   const robot::RobotDescription& robot = simulator_.robot();
   std::map<std::string, double> joints;
   const std::vector<std::string> names = robot.ArmJointNames();
   for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = truth.arm_position[i];
   for (const LinkCylinder& cylinder : links_) {
     const Eigen::Isometry3d T_map_link = truth.T_map_base * robot.FramePose(cylinder.link, joints);
-    const Eigen::Vector3d a = T_map_link * cylinder.a, b = T_map_link * cylinder.b;
-    const int samples = std::max(2, static_cast<int>(std::ceil((b - a).norm() / 0.01)) + 1);
-    for (int k = 0; k < samples; ++k) {
-      if (foliage.Reaches(a + (b - a) * (static_cast<double>(k) / (samples - 1)), cylinder.radius)) return true;
+    if (foliage.ReachesCylinder(T_map_link * cylinder.a, T_map_link * cylinder.b, cylinder.radius)) {
+      return cylinder.link;
     }
   }
-  return false;
+  return {};
 }
 
 void TrimEvaluator::Observe(const StepView& step) {
@@ -90,9 +88,12 @@ void TrimEvaluator::Observe(const StepView& step) {
   }
   trim->outcome.arm_contacts += contact_events_.Update(step.truth.arm_contacts);
   if (steps_ % kTouchEvery != 0) return;
-  const bool in_foliage = LinksInFoliage(step.truth, *simulator_.foliage(trim->outcome.bush));
-  if (in_foliage && !trim->touching) ++trim->outcome.foliage_touches;
-  trim->touching = in_foliage;
+  const std::string link = LinkInFoliage(step.truth, *simulator_.foliage(trim->outcome.bush));
+  if (!link.empty() && !trim->touching) {
+    ++trim->outcome.foliage_touches;
+    ++trim->outcome.foliage_touches_by[link + " while " + telemetry->trim->stage];
+  }
+  trim->touching = !link.empty();
 }
 
 void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
@@ -110,6 +111,8 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.path_source = report.path_source;
   o.motion_seconds = report.motion_time;
   o.nearest_neighbour_seconds = report.nearest_neighbour_time;
+  o.leaf_depth_m = report.leaf_depth;
+  o.moves_round_the_leaves = report.moves_round_the_leaves;
   trim->planning_seconds = report.planning_seconds;
   if (!report.fit) return;
   // The fit in base_link, placed where the base truly stood, against the true target.

@@ -52,8 +52,9 @@ class TrimEvaluator : public Observer {
     double planning_seconds = -1.0;
     bool touching = false;
   };
-  // Whether an arm link other than the blade reaches into the foliage at the true joint positions.
-  bool LinksInFoliage(const sim::GroundTruth& truth, const garden::Foliage& foliage) const;
+  // An arm link other than the blade that reaches into the foliage at the true joint positions (the
+  // first found; empty: none).
+  std::string LinkInFoliage(const sim::GroundTruth& truth, const garden::Foliage& foliage) const;
   void Record(const stack::TrimResult& result, double now);
 
   const sim::Simulator& simulator_;

@@ -134,6 +134,7 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
     const garden::GardenObject& bush = BushOf(surveyed, goal.bush, scenario, ApproachBush(goal.bush));
     if (!goal.trim) {
       goals.push_back(stack::Goal::ApproachBush(bush.position, ShapeOf(bush)));
+      goals.back().side = goal.side;
       continue;
     }
     if (bush.object_class != garden::ObjectClass::kTopiary) {
@@ -144,6 +145,7 @@ std::vector<stack::Goal> MissionGoals(const Scenario& scenario, const garden::Ga
     }
     goals.push_back(goal.cut ? stack::Goal::TrimBush(bush.position, ShapeOf(bush))
                              : stack::Goal::ScanBush(bush.position, ShapeOf(bush)));
+    goals.back().side = goal.side;
   }
   return goals;
 }

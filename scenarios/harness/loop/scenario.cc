@@ -147,6 +147,7 @@ void ReadMission(const YamlMap& root, Scenario& s) {
       const char* key = g.cut ? "trim_bush" : g.trim ? "scan_bush" : "approach_bush";
       g.bush = goal.Integer(key, 1, garden::kMaxGardenObjectId);  // checked against the garden later
       if (goal.Has("yaw_deg")) goal.Fail("yaw_deg", "a bush goal's heading is the bush's bearing (give none)");
+      if (goal.Has("side_deg")) g.side = goal.Number("side_deg", -360.0, 360.0, "deg") * M_PI / 180.0;
     } else {
       g.position = {goal.Number("x", -1e4, 1e4, "m"), goal.Number("y", -1e4, 1e4, "m")};
       if (goal.Has("yaw_deg")) g.yaw = goal.Number("yaw_deg", -360.0, 360.0, "deg") * M_PI / 180.0;

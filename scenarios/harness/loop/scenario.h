@@ -64,14 +64,16 @@ struct Survey {
 // A goal of the mission: a point in the map frame, or a bush of the garden to approach for
 // trimming (`approach_bush: ID`: by map to ~1 m, then visual servoing to the standoff), or to
 // approach and trim from the standoff (`trim_bush: ID`, a topiary; the same bush from several
-// standoffs: point goals between them lead the base round it), or to approach and scan only
-// (`scan_bush: ID`: the scan joins the bush's later trims' fits).
+// standoffs), or to approach and scan only (`scan_bush: ID`: the scan joins the bush's later trims'
+// fits). A bush goal's `side_deg` asks for the side of the bush to stand at (the bearing from its
+// centre, map frame: 0 east, 90 north); unset, the free side nearest to where the robot comes from.
 struct ScenarioGoal {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // a point goal's (a bush's: see MissionGoals)
   std::optional<double> yaw;                           // rad, map frame (`yaw_deg`): a point goal's heading; unset: any
   int bush = 0;                                        // the garden object's id; 0: a point goal
   bool trim = false;                                   // scanned once approached (`scan_bush`) ...
   bool cut = false;                                    // ... and trimmed (`trim_bush`)
+  std::optional<double> side;                          // rad, map frame (`side_deg`): a bush goal's side; unset: any
 };
 
 // How far a goal's heading may be off when the scenario gives one: Nav2's default

@@ -13,10 +13,12 @@ int ImportGardenCsv(const std::string& csv, const std::string& name, double grou
 
 // "WxH" in metres, both in (2, garden::kMaxGardenExtent]; InputError naming --size otherwise.
 Eigen::Vector2d ParseGardenSize(const std::string& text);
-// A garden made from `parameters` at `output` ("" or "-": standard output); `arguments` are quoted
-// in the file's first comment, to make it again.
-int GenerateGardenFile(const garden::GeneratorParameters& parameters, const std::string& arguments,
-                       const std::string& output);
+// The `trimbot garden generate` options that make the garden of `parameters` (all of them, so the
+// command still makes it when the defaults change).
+std::string GeneratorArguments(const garden::GeneratorParameters& parameters);
+// A garden made from `parameters` at `output` ("" or "-": standard output); its first comment
+// quotes the command that makes it again.
+int GenerateGardenFile(const garden::GeneratorParameters& parameters, const std::string& output);
 
 struct GardenExport {
   std::string garden;  // name or file

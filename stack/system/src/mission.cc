@@ -10,6 +10,10 @@
 namespace trimbot::stack {
 namespace {
 
+// How far from the side a bush goal asks for its approach may be (rad): the free side nearest to
+// it within a quarter turn either way (a box's corners are 45 deg off its faces' normals).
+constexpr double kSideTolerance = M_PI / 4.0;
+
 // A planar point through a (planar) transform.
 Eigen::Vector2d Apply(const Eigen::Isometry3d& T, const Eigen::Vector2d& p) {
   return (T * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>();
@@ -100,6 +104,7 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
   // Of the sides of the bush where the base's outline at the standoff clears the map (other than
   // the bush), the nearest to where the robot comes from whose approach point the outline fits at
   // facing the bush (the servo turns there to face it); failing that, one where it fits at all.
+  // A goal that names its side: the free side nearest to it, within kSideTolerance.
   const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
   const double reach = standoff + parameters_.bush_approach.approach_margin + arm_axis_.x();
   // Sides every 10 deg; a box only towards its corners (+-15 deg), where two faces show: seen
@@ -114,8 +119,15 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
   } else {
     for (int k = 0; k < 36; ++k) sides.push_back(2.0 * M_PI * k / 36.0);
   }
+  if (goal.side) {
+    sides.erase(std::remove_if(sides.begin(), sides.end(),
+                               [&](double angle) { return std::abs(WrapAngle(angle - *goal.side)) > kSideTolerance; }),
+                sides.end());
+    if (sides.empty()) sides.push_back(*goal.side);  // a box's corner is that far off: the side itself
+  }
   for (const bool facing_the_bush : {true, false}) {
     std::optional<Eigen::Vector2d> best;
+    double best_score = 0.0;
     for (const double angle : sides) {
       const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
       const Eigen::Vector2d approach = goal.position + reach * side;
@@ -125,13 +137,19 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
                                         : navigator.planner().FreeHeading(approach).has_value();
       const double wanted = 2.0 * parameters_.navigation.stop_clearance;
       if (!fits || navigator.OutlineClearance(facing, wanted) < wanted) continue;
-      if (!best || (approach - from).norm() < (*best - from).norm()) best = approach;
+      const double score = goal.side ? std::abs(WrapAngle(angle - *goal.side)) : (approach - from).norm();
+      if (!best || score < best_score) {
+        best = approach;
+        best_score = score;
+      }
     }
     if (best) return *best;
   }
-  // No side is free: straight from where the robot comes (the navigator moves the point or says why).
-  const Eigen::Vector2d away =
-      (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized() : Eigen::Vector2d(-1.0, 0.0);
+  // No side is free: the side asked for, or straight from where the robot comes (the navigator
+  // moves the point or says why).
+  const Eigen::Vector2d away = goal.side ? Eigen::Vector2d(std::cos(*goal.side), std::sin(*goal.side))
+                               : (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized()
+                                                                      : Eigen::Vector2d(-1.0, 0.0);
   return goal.position + reach * away;
 }
 
@@ -285,7 +303,7 @@ void Mission::RunTrim(double stamp, Navigator* navigator, messages::RobotCommand
   }
   if (auto command = trim_->Update(stamp)) commands->arm = *command;
   commands->cutter = messages::CutterCommand{trim_->cutting()};
-  telemetry->trim = TrimStatus{bush_goal_, trimming::ToString(trim_->mode())};
+  telemetry->trim = TrimStatus{bush_goal_, trimming::ToString(trim_->mode()), trim_->Stage(stamp)};
   if (trim_->active()) return;
   telemetry->trim_results.push_back({bush_goal_, trim_->report()});
   telemetry->trim.reset();

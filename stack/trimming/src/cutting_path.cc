@@ -84,14 +84,13 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
   return poses;
 }
 
-CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
-                                const perception::TopiaryShape& target, double tolerance, double step) {
-  // The shrunk target's surface on a polar grid (rings x segments plus the two poles), as a convex
-  // polyhedron (a superellipsoid of exponents >= 2 is convex).
+void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset) {
+  // The target's surface moved along its radii on a polar grid (rings x segments plus the two
+  // poles), as a convex polyhedron (a superellipsoid of exponents >= 2 is convex).
   constexpr int kRings = 16, kSegments = 32;
   std::vector<Eigen::Vector3d> vertices;
   const auto surface = [&](const Eigen::Vector3d& d) {
-    return Eigen::Vector3d(target.centre + std::max(0.0, target.Radius(d) - tolerance) * d);
+    return Eigen::Vector3d(target.centre + std::max(0.0, target.Radius(d) + offset) * d);
   };
   vertices.push_back(surface(Eigen::Vector3d::UnitZ()));
   for (int r = 1; r < kRings; ++r) {
@@ -117,6 +116,11 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::Col
   collision->environment().Clear();
   collision->environment().AddGround("ground", 0.0);
   collision->environment().AddConvex("target", vertices, triangles);
+}
+
+CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
+                                const perception::TopiaryShape& target, double tolerance, double step) {
+  SetTargetEnvironment(collision, target, -tolerance);
   CuttingChecks checks;
   checks.valid = [collision](const Eigen::VectorXd& q) { return !collision->Check(q).collision; };
   checks.free_move = [&kinematics, valid = checks.valid, step](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {

@@ -1,5 +1,6 @@
 #include "trimbot/trimming/trim_executive.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -9,6 +10,22 @@ namespace {
 
 Eigen::VectorXd ToVector(const messages::ArmJointState& joints) {
   return Eigen::Map<const Eigen::VectorXd>(joints.position.data(), static_cast<int>(joints.position.size()));
+}
+
+// The joint path shifted to begin at `first` (the same arm poses: `first` differs from its first
+// configuration by whole turns of continuous joints).
+std::vector<Eigen::VectorXd> BeginningAt(std::vector<Eigen::VectorXd> path, const Eigen::VectorXd& first) {
+  const Eigen::VectorXd shift = first - path.front();
+  for (Eigen::VectorXd& q : path) q += shift;
+  return path;
+}
+
+// The q-quantile of `values` (0 when empty).
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
 }
 
 }  // namespace
@@ -141,6 +158,12 @@ std::optional<messages::ArmCommand> TrimExecutive::Update(double stamp) {
   return command;
 }
 
+std::string TrimExecutive::Stage(double stamp) const {
+  if (mode_ != Mode::kCutting) return ToString(mode_);
+  const double t = stamp - motion_start_;
+  return t < cut_begins_ ? "moving in" : t > cut_ends_ ? "moving out" : "cutting";
+}
+
 void TrimExecutive::Fit(double stamp) {
   const auto begin = std::chrono::steady_clock::now();
   const std::vector<Eigen::Vector3d> bush = ScansOfTheBush();
@@ -153,6 +176,10 @@ void TrimExecutive::Fit(double stamp) {
   }
   report_.fit = fit->shape;
   target_shape_ = fit->shape;
+  std::vector<double> outside;
+  for (const Eigen::Vector3d& p : bush) outside.push_back(std::max(0.0, fit->shape.RadialDistance(p)));
+  leaf_depth_ = Quantile(outside, parameters_.leaf_quantile);
+  report_.leaf_depth = leaf_depth_;
   report_.fit_loss = fit->loss;
   report_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   mode_ = Mode::kFitted;
@@ -216,6 +243,15 @@ void TrimExecutive::Plan(double stamp) {
   }
   trajectory_ = arm::TimeParameterize(waypoints, limits, parameters_.planner.acceleration);
   report_.cutting_duration = trajectory_.duration();
+  // Rest-to-rest segments: the parts' durations add up.
+  const auto duration = [&](std::size_t from, std::size_t to) {
+    return arm::TimeParameterize({waypoints.begin() + static_cast<std::ptrdiff_t>(from),
+                                  waypoints.begin() + static_cast<std::ptrdiff_t>(to) + 1},
+                                 limits, parameters_.planner.acceleration)
+        .duration();
+  };
+  cut_begins_ = duration(0, first_blade_waypoint_);
+  cut_ends_ = trajectory_.duration() - duration(last_blade_waypoint_, waypoints.size() - 1);
   motion_start_ = stamp;
   target_ = trajectory_.positions.front();
   mode_ = Mode::kCutting;
@@ -224,11 +260,24 @@ void TrimExecutive::Plan(double stamp) {
 std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, std::string* failure) {
   std::vector<Eigen::VectorXd> waypoints{path.configurations.front()};
   for (std::size_t i = 0; i + 1 < path.configurations.size(); ++i) {
+    if (i == 1) first_blade_waypoint_ = waypoints.size() - 1;
+    if (i + 2 == path.configurations.size()) last_blade_waypoint_ = waypoints.size() - 1;
     const Eigen::VectorXd from = waypoints.back();
     const Eigen::VectorXd to = from + kinematics_.JointDifference(from, path.configurations[i + 1]);
     if (!path.planned[i]) {
       waypoints.push_back(to);
       continue;
+    }
+    // In from the start and out back to it: round the leaves.
+    const bool in = i == 0, out = i + 2 == path.configurations.size();
+    if (in || out) {
+      std::vector<Eigen::VectorXd> way = in ? IntoTheLeaves(from, to) : IntoTheLeaves(to, from);
+      if (!way.empty()) {
+        if (out) way = BeginningAt({way.rbegin(), way.rend()}, from);
+        waypoints.insert(waypoints.end(), way.begin() + 1, way.end());
+        ++report_.moves_round_the_leaves;
+        continue;
+      }
     }
     const arm::ArmPlan plan = planner_->PlanToJoints(from, to);
     if (!plan.ok) {
@@ -239,6 +288,30 @@ std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, s
     ++report_.planned_moves;
   }
   return waypoints;
+}
+
+std::vector<Eigen::VectorXd> TrimExecutive::IntoTheLeaves(const Eigen::VectorXd& outside,
+                                                          const Eigen::VectorXd& at_blade) {
+  // Drawn back along the blade's axis past the leaves: from blade_depth inside the fit to
+  // leaf_clearance beyond the leaves' depth, and the disc's thickness.
+  const Eigen::Isometry3d cutter = kinematics_.EndEffectorPose(at_blade);
+  const Eigen::Vector3d into = cutter.linear() * T_cutter_blade_.linear().col(2);
+  constexpr double kDiscClearance = 0.01;  // m
+  Eigen::Isometry3d back = cutter;
+  back.translation() -= (parameters_.blade_depth + leaf_depth_ + parameters_.leaf_clearance + kDiscClearance) * into;
+  const arm::ArmPlan drawn_back = planner_->CartesianPass(at_blade, back);  // within the shrunk target's
+  if (!drawn_back.ok) return {};
+  SetTargetEnvironment(collision_.get(), target_shape_, leaf_depth_ + parameters_.leaf_clearance);
+  planner_->ResetRoadmap();
+  const arm::ArmPlan round = planner_->PlanToJoints(outside, drawn_back.waypoints.back());
+  SetTargetEnvironment(collision_.get(), target_shape_, -parameters_.tolerance);
+  planner_->ResetRoadmap();
+  if (!round.ok) return {};
+  std::vector<Eigen::VectorXd> way = round.waypoints;
+  const std::vector<Eigen::VectorXd> in =
+      BeginningAt({drawn_back.waypoints.rbegin(), drawn_back.waypoints.rend()}, way.back());
+  way.insert(way.end(), in.begin() + 1, in.end());
+  return way;
 }
 
 void TrimExecutive::Finish(double stamp, const std::string& failure) {

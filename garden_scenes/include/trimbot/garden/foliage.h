@@ -86,8 +86,13 @@ class Foliage {
   // Where the foliage ends along a unit direction from the centre (centre frame): the nearest
   // column's radius.
   double RadiusAlong(const Eigen::Vector3d& direction) const;
-  // Whether a map point lies within `margin` of the foliage (inside it, or that close outside).
-  bool Reaches(const Eigen::Vector3d& point, double margin = 0.0) const;
+  // Whether a map point lies inside the foliage.
+  bool Reaches(const Eigen::Vector3d& point) const;
+  // Whether a solid cylinder (axis end points `a`, `b` in the map frame, `radius`) reaches into the
+  // foliage: its axis, its mantle and its end caps sampled every centimetre. A point test with the
+  // radius as a margin along the ray from the bush's centre would not do: it counts an end cap just
+  // behind a blade that has cut the leaves in front of it as in them.
+  bool ReachesCylinder(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const;
   // Columns shortened by cuts so far (a drawing of the foliage is stale when it grew).
   long cut_columns() const { return cut_columns_; }
 

@@ -21,6 +21,8 @@ struct GeneratorParameters {
   std::uint64_t seed = 0;
   Eigen::Vector2d size = Eigen::Vector2d(16, 12);
   int topiary = 8;
+  double topiary_box_share = 0.3;       // of the topiaries shaped as boxes (drawn per bush) ...
+  double topiary_cylinder_share = 0.0;  // ... and as cylinders; the rest ellipsoids
   int roses = 4;
   int hedges = 2;
   int trees = 2;
@@ -32,6 +34,7 @@ struct GeneratorParameters {
   Eigen::Vector2d corridor_width = Eigen::Vector2d(1.0, 1.2);  // m, min and max
   bool fence = true;                                           // a low fence around the garden
   double robot_clearance = 0.9;  // m of free space kept between objects so the robot can pass
+  double fence_clearance = 0.5;  // m kept between objects and the garden's edge
 };
 // A new garden from the parameters; the same seed gives the same garden. Objects do not overlap
 // each other or the paths and keep robot_clearance between them.

@@ -21,6 +21,7 @@ struct Goal {
   Eigen::Vector2d position;                   // the point, or the bush's surveyed centre
   std::optional<double> yaw;                  // a point goal's heading to arrive with (map frame, rad); unset: any
   std::optional<perception::BushShape> bush;  // set for a bush approach
+  std::optional<double> side;                 // a bush approach's side: bearing from the bush's centre (map frame, rad)
   bool trim = false;                          // the bush is scanned once approached ...
   bool cut = false;                           // ... and trimmed
 };

@@ -104,8 +104,9 @@ struct ArmStatus {
 
 // A trim under way (a trim goal's bush, approached).
 struct TrimStatus {
-  int goal = 0;      // index into the goals
-  std::string mode;  // TrimExecutive's mode
+  int goal = 0;       // index into the goals
+  std::string mode;   // TrimExecutive's mode
+  std::string stage;  // and while cutting its part: moving in, cutting, moving out (TrimExecutive::Stage)
 };
 
 // A trim finished, for its goal.

@@ -67,6 +67,10 @@ struct CuttingPath {
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration);
 
+// The arm's collision model's environment: the ground and the target's surface moved `offset`
+// outward along its radii (negative: into it) as a solid convex polyhedron.
+void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset);
+
 // The collision checks of a cutting path on the arm's collision model, whose environment becomes
 // the ground and the target shrunk by `tolerance` as a solid (convex) polyhedron: the blade may go
 // that deep, and the surface it leaves stays within tolerance of the target. A move is free when

@@ -11,12 +11,16 @@
 //                          adapted (CuttingPathDatabase, when one is given and holds a target
 //                          near enough) or solved in full (PlanCuttingPath)
 //     -> cut               one joint trajectory through the path, the blade spinning; the moves
-//                          the path leaves to the planner are planned round the target
+//                          the path leaves to the planner are planned round the target; the arm
+//                          comes in to the first blade pose and leaves the last round the leaves
+//                          as the scan saw them, then along the blade's axis (the blade cutting its
+//                          way in and out)
 //     -> done              the arm back at its start; report()
 //
 // The collision model's environment is the ground and the fitted target shrunk by the cut's
-// tolerance (MakeCuttingChecks): the leaves outside it are what the blade is there to cut. Nothing
-// here sees ground truth.
+// tolerance (MakeCuttingChecks): the leaves outside it are what the blade is there to cut. For
+// the moves in and out it is the target grown by the leaves' depth the scan measured, so no link
+// but the blade goes into them. Nothing here sees ground truth.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <map>
@@ -47,6 +51,8 @@ struct TrimParameters {
   CuttingPathOptions path;
   double tolerance = 0.02;              // m the blade may go into the fitted target
   double blade_depth = 0.01;            // m inside the fitted surface the blade is aimed at (<= tolerance)
+  double leaf_quantile = 0.95;          // of the bush's points' distances outside the fit: the leaves' depth
+  double leaf_clearance = 0.03;         // m kept from the leaves moving in and out
   double database_max_distance = 0.15;  // m: a stored target farther than this is solved in full
   arm::ArmPlannerParameters planner;    // the moves round the bush; its speeds time the whole cut
   double settle_tolerance = 0.002;      // rad
@@ -70,6 +76,9 @@ struct TrimReport {
   double nearest_neighbour_time = 0.0;  // s: the greedy tour's, when solved in full
   double cutting_duration = 0.0;        // s: the trajectory executed
   int planned_moves = 0;                // moves planned round the target
+  double leaf_depth = 0.0;              // m: the leaves outside the fit, as the scan saw them (leaf_quantile)
+  int moves_round_the_leaves = 0;       // of the moves in and out (2 at most): round the leaves, then along the
+                                        // blade's axis (the others round the shrunk target only: no such way found)
 };
 
 class TrimExecutive {
@@ -102,8 +111,14 @@ class TrimExecutive {
   Mode mode() const { return mode_; }
   bool active() const { return mode_ != Mode::kIdle && mode_ != Mode::kDone; }
   bool cutting() const { return mode_ == Mode::kCutting; }  // the blade spins
+  // The mode's name; while cutting, which part of the trajectory runs: "moving in" (to the first
+  // blade pose), "cutting" (the path), "moving out" (from the last back to the start).
+  std::string Stage(double stamp) const;
   const TrimReport& report() const { return report_; }
   const arm::JointTrajectory& trajectory() const { return trajectory_; }
+  // s into trajectory(): the blade at its first pose, and leaving its last.
+  double cut_begins() const { return cut_begins_; }
+  double cut_ends() const { return cut_ends_; }
 
  private:
   // The target from the scan; fails the trim with the reason when there is none.
@@ -119,6 +134,11 @@ class TrimExecutive {
   // The joint path through the cutting path's configurations (planned moves round the target),
   // continuous joints unwrapped from the start; empty with *failure set when a move cannot be planned.
   std::vector<Eigen::VectorXd> Waypoints(const CuttingPath& path, std::string* failure);
+  // From `outside` (clear of the leaves) to `at_blade` (a blade pose): round the leaves as the scan
+  // saw them to the blade pose drawn back along the blade's axis, then in along it. Starts at
+  // `outside`; ends where `at_blade` puts the blade (continuous joints maybe a turn off); empty
+  // when there is no such way.
+  std::vector<Eigen::VectorXd> IntoTheLeaves(const Eigen::VectorXd& outside, const Eigen::VectorXd& at_blade);
 
   TrimParameters parameters_;
   arm::ArmKinematics kinematics_;
@@ -135,11 +155,14 @@ class TrimExecutive {
   Eigen::Isometry3d T_map_base_ = Eigen::Isometry3d::Identity();  // estimated, at the scan
   std::map<int, std::vector<Eigen::Vector3d>> scans_;             // each bush's scans, map frame
   perception::TopiaryShape target_shape_;                         // fitted, in the current base_link
+  double leaf_depth_ = 0.0;                                       // m outside it (report_.leaf_depth)
   std::vector<Eigen::Vector3d> points_;
   std::vector<Eigen::Matrix3d> covariances_;
   std::optional<messages::ArmJointState> joints_;
   arm::JointTrajectory trajectory_;
   double motion_start_ = 0.0, settle_start_ = 0.0;
+  double cut_begins_ = 0.0, cut_ends_ = 0.0;                        // s into trajectory_
+  std::size_t first_blade_waypoint_ = 0, last_blade_waypoint_ = 0;  // in Waypoints()' result
   Eigen::VectorXd target_;
   TrimReport report_;
 };
