@@ -199,6 +199,17 @@ TEST(CuttingPath, ABushOutOfReachIsAFailureWithTheReason) {
   EXPECT_NE(path.failure.find("no blade pose"), std::string::npos) << path.failure;
 }
 
+// A topiary ball of 0.6 m (its target) standing at `position`.
+garden::GardenObject TopiaryBall(const Eigen::Vector2d& position) {
+  garden::GardenObject bush;
+  bush.id = 1;
+  bush.object_class = garden::ObjectClass::kTopiary;
+  bush.shape = garden::Shape::kEllipsoid;
+  bush.size = {0.6, 0.6, 0.6};
+  bush.position = position;
+  return bush;
+}
+
 // The share of the foliage's surface within 2 cm of the target among the columns facing
 // `towards` (map frame).
 double FacingShareWithin2cm(const garden::Foliage& foliage, const Eigen::Vector3d& towards) {
@@ -255,12 +266,7 @@ void SweepBlade(const Fixture& f, const CuttingPath& path, const Eigen::Isometry
 // reported (issue 31's targets, >= 90 % and < 1 %, are for the closed loop).
 TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
   Fixture f;
-  garden::GardenObject bush;
-  bush.id = 1;
-  bush.object_class = garden::ObjectClass::kTopiary;
-  bush.shape = garden::Shape::kEllipsoid;
-  bush.size = {0.6, 0.6, 0.6};
-  bush.position = {2.0, 1.0};
+  const garden::GardenObject bush = TopiaryBall({2.0, 1.0});
   garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.05 / (0.15 * 1.6));  // shoots up to 5 cm
   const garden::CutQuality before = foliage.Measure();
   Rng rng = MakeRng(4, "leaves");
@@ -369,12 +375,7 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
   const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
   const arm::ArmKinematics kinematics(robot);
   const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
-  garden::GardenObject bush;
-  bush.id = 1;
-  bush.object_class = garden::ObjectClass::kTopiary;
-  bush.shape = garden::Shape::kEllipsoid;
-  bush.size = {0.6, 0.6, 0.6};
-  bush.position = {0.95, 0.0};
+  const garden::GardenObject bush = TopiaryBall({0.95, 0.0});
   garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.35);  // a bush due for trimming
   Rng rng = MakeRng(5, "leaves");
   const std::vector<Eigen::Vector3d> seen =
