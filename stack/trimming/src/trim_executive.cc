@@ -178,8 +178,7 @@ void TrimExecutive::Fit(double stamp) {
   target_shape_ = fit->shape;
   std::vector<double> outside;
   for (const Eigen::Vector3d& p : bush) outside.push_back(std::max(0.0, fit->shape.RadialDistance(p)));
-  leaf_depth_ = Quantile(outside, parameters_.leaf_quantile);
-  report_.leaf_depth = leaf_depth_;
+  report_.leaf_depth = Quantile(outside, parameters_.leaf_quantile);
   report_.fit_loss = fit->loss;
   report_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   mode_ = Mode::kFitted;
@@ -260,16 +259,16 @@ void TrimExecutive::Plan(double stamp) {
 std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, std::string* failure) {
   std::vector<Eigen::VectorXd> waypoints{path.configurations.front()};
   for (std::size_t i = 0; i + 1 < path.configurations.size(); ++i) {
+    // In from the start and out back to it: round the leaves.
+    const bool in = i == 0, out = i + 2 == path.configurations.size();
     if (i == 1) first_blade_waypoint_ = waypoints.size() - 1;
-    if (i + 2 == path.configurations.size()) last_blade_waypoint_ = waypoints.size() - 1;
+    if (out) last_blade_waypoint_ = waypoints.size() - 1;
     const Eigen::VectorXd from = waypoints.back();
     const Eigen::VectorXd to = from + kinematics_.JointDifference(from, path.configurations[i + 1]);
     if (!path.planned[i]) {
       waypoints.push_back(to);
       continue;
     }
-    // In from the start and out back to it: round the leaves.
-    const bool in = i == 0, out = i + 2 == path.configurations.size();
     if (in || out) {
       std::vector<Eigen::VectorXd> way = in ? IntoTheLeaves(from, to) : IntoTheLeaves(to, from);
       if (!way.empty()) {
@@ -298,10 +297,11 @@ std::vector<Eigen::VectorXd> TrimExecutive::IntoTheLeaves(const Eigen::VectorXd&
   const Eigen::Vector3d into = cutter.linear() * T_cutter_blade_.linear().col(2);
   constexpr double kDiscClearance = 0.01;  // m
   Eigen::Isometry3d back = cutter;
-  back.translation() -= (parameters_.blade_depth + leaf_depth_ + parameters_.leaf_clearance + kDiscClearance) * into;
+  back.translation() -=
+      (parameters_.blade_depth + report_.leaf_depth + parameters_.leaf_clearance + kDiscClearance) * into;
   const arm::ArmPlan drawn_back = planner_->CartesianPass(at_blade, back);  // within the shrunk target's
   if (!drawn_back.ok) return {};
-  SetTargetEnvironment(collision_.get(), target_shape_, leaf_depth_ + parameters_.leaf_clearance);
+  SetTargetEnvironment(collision_.get(), target_shape_, report_.leaf_depth + parameters_.leaf_clearance);
   planner_->ResetRoadmap();
   const arm::ArmPlan round = planner_->PlanToJoints(outside, drawn_back.waypoints.back());
   SetTargetEnvironment(collision_.get(), target_shape_, -parameters_.tolerance);

@@ -155,7 +155,6 @@ class TrimExecutive {
   Eigen::Isometry3d T_map_base_ = Eigen::Isometry3d::Identity();  // estimated, at the scan
   std::map<int, std::vector<Eigen::Vector3d>> scans_;             // each bush's scans, map frame
   perception::TopiaryShape target_shape_;                         // fitted, in the current base_link
-  double leaf_depth_ = 0.0;                                       // m outside it (report_.leaf_depth)
   std::vector<Eigen::Vector3d> points_;
   std::vector<Eigen::Matrix3d> covariances_;
   std::optional<messages::ArmJointState> joints_;
