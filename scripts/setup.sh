@@ -16,6 +16,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev python3
   clang clang-format libclang-rt-dev
   slurmctld slurmd slurm-client munge
+  chromium  # the report test opens report.html headless (issue 32)
 )
 
 missing=()

@@ -52,5 +52,6 @@ void AddMapCommands(Commands& commands);     // map build | ensure | bench | ret
 void AddFusionCommand(Commands& commands);
 void AddStereoCommand(Commands& commands);
 void AddTrimCommands(Commands& commands);  // trim precompute
+void AddReportCommand(Commands& commands);
 
 }  // namespace trimbot::scenarios

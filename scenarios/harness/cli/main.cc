@@ -23,5 +23,6 @@ int main(int argc, char** argv) {
   AddFusionCommand(commands);
   AddStereoCommand(commands);
   AddTrimCommands(commands);
+  AddReportCommand(commands);
   return commands.ParseAndRun(argc, argv);
 }

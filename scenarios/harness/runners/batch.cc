@@ -26,6 +26,7 @@
 #include "reports/arm_plot.h"
 #include "reports/batch_report.h"
 #include "reports/bush_plot.h"
+#include "reports/html_report.h"
 #include "reports/localization_timing.h"
 #include "reports/run_timing.h"
 #include "runners/map_cache.h"
@@ -286,6 +287,7 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
     WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth",
                        results);
   }
+  WriteHtmlReport(out);
 
   log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
   for (const auto& r : results) log << "  " << OneLine(r) << "\n";
@@ -297,7 +299,7 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
   if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
   LogPlanTimes(log, "navigation planning (wall clock, goal candidates included)", timing.navigation_planning);
   LogPlanTimes(log, "arm planning (wall clock, IK included)", timing.arm_planning);
-  log << "outputs in " << final_out << " (summary.json, junit.xml, timing.json, timing.png, "
+  log << "outputs in " << final_out << " (report.html, summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach
               ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"
               : "trajectories.png, localization_errors.png; with bush goals bush_frames.png, bush_errors.png)\n");

@@ -1,4 +1,5 @@
 #include "runners/compare.h"
+#include "reports/html_report.h"
 
 #include <filesystem>
 #include <fstream>
@@ -36,6 +37,7 @@ int RunCompare(CompareOptions options) {
     WriteFileAtomically(options.out + "/comparison.json", ToJson(comparison).dump(2));
     WriteFileAtomically(options.out + "/comparison.md", markdown);
     WriteFileAtomically(options.out + "/junit.xml", ToJunitXml(comparison));
+    WriteHtmlReport(options.out);
   }
   return comparison.regressed ? 1 : 0;
 }

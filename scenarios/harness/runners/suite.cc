@@ -20,6 +20,7 @@
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "reports/batch_report.h"
+#include "reports/html_report.h"
 #include "runners/batch.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
@@ -358,6 +359,7 @@ int WriteSuiteReports(const SuiteSpec& spec, const SuiteOptions& options, const 
      << 100.0 * summary.metrics.value("goal_success_rate_as_asked", 0.0)
      << " %); contacts: " << summary.metrics.value("collisions", 0.0) << "\n";
   WriteFileAtomically(out + "/suite.md", md.str());
+  WriteHtmlReport(out);
 
   std::cout << "\n"
             << spec.name << ": " << gardens << " gardens, goals reached "
@@ -375,7 +377,8 @@ int WriteSuiteReports(const SuiteSpec& spec, const SuiteOptions& options, const 
     std::cout << "  " << (c.pass ? "pass " : "FAIL ") << c.name << " " << c.comparison << " " << c.expected
               << " (actual " << c.actual << ")\n";
   }
-  std::cout << "outputs in " << out << " (summary.json, junit.xml, suite.json, suite.md; per garden gardens/NNN/)\n";
+  std::cout << "outputs in " << out
+            << " (report.html, summary.json, junit.xml, suite.json, suite.md; per garden gardens/NNN/)\n";
   return summary.pass ? 0 : 1;
 }
 

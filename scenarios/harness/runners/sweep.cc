@@ -10,6 +10,7 @@
 #include "evaluation/comparison.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
+#include "reports/html_report.h"
 #include "reports/sweep_plot.h"
 #include "runners/batch_executor.h"
 #include "trimbot/common/atomic_file.h"
@@ -186,7 +187,8 @@ int RunSweep(const SweepOptions& options) {
   WriteFileAtomically(options.out_dir + "/sweep.json", sweep.dump(2));
   WriteFileAtomically(options.out_dir + "/sweep.csv", Csv(grids, results));
   WritePlots(options.out_dir, name, grids, points, results);
-  std::cout << "[sweep] outputs in " << options.out_dir << " (sweep.csv, sweep.json, plots/)" << std::endl;
+  WriteHtmlReport(options.out_dir);
+  std::cout << "[sweep] outputs in " << options.out_dir << " (report.html, sweep.csv, sweep.json, plots/)" << std::endl;
   return 0;
 }
 

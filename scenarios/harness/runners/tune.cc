@@ -14,6 +14,7 @@
 
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
+#include "reports/html_report.h"
 #include "reports/sweep_plot.h"
 #include "runners/batch.h"
 #include "trimbot/common/atomic_file.h"
@@ -231,6 +232,7 @@ int RunTune(const TuneOptions& options) {
       {"improved_on_fresh_seeds", better}};
   WriteFileAtomically(options.out_dir + "/tune.json", report.dump(2));
   WriteConvergencePlot(options.out_dir + "/convergence.png", options, search);
+  WriteHtmlReport(options.out_dir);
   std::cout << std::setprecision(5) << "[tune] " << stop << " after " << search.evaluations().size()
             << " evaluations. Best:";
   for (const auto& o : best.overrides) std::cout << " " << o;
