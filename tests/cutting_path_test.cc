@@ -60,6 +60,38 @@ TEST(CuttingPath, BladePosesLieOnTheTargetFacingTheRobot) {
   }
 }
 
+// The flat top of a cylinder faces no standoff (its normal is vertical): each standoff takes the
+// sector on its side of the centre, blade pointing down, and the robot's own arm reaches it.
+TEST(CuttingPath, EachStandoffTakesItsSectorOfTheCrown) {
+  Fixture f;
+  perception::TopiaryShape cylinder;
+  cylinder.vertical_exponent = 6.0;
+  cylinder.half = {0.3, 0.3, 0.3};
+  cylinder.centre = {0.95, 0.0, 0.3};
+  SetTargetEnvironment(&f.collision, cylinder, -0.02);
+  int top = 0, reached = 0;
+  for (const Eigen::Isometry3d& pose : CuttingPoses(cylinder)) {
+    if (pose.translation().z() < 0.59) continue;  // the top face (the surface within 1 cm of it)
+    ++top;
+    const Eigen::Vector2d from_centre = (pose.translation() - cylinder.centre).head<2>();
+    EXPECT_LE(std::abs(from_centre.y()), -from_centre.x() + 1e-9) << "within 45 deg of the base's bearing";
+    EXPECT_LT(pose.linear().col(2).z(), -0.7) << "the blade's axis down into the top";
+    for (int r = 0; r < 6; ++r) {
+      const Eigen::Isometry3d blade = pose * Eigen::AngleAxisd(M_PI / 3 * r, Eigen::Vector3d::UnitZ());
+      const auto solutions = f.kinematics.InverseKinematics(blade * f.T_cutter_blade.inverse()).solutions;
+      if (std::any_of(solutions.begin(), solutions.end(), [&](const Eigen::VectorXd& q) { return f.Valid(q); })) {
+        ++reached;
+        break;
+      }
+    }
+  }
+  std::printf("cylinder's top: %d blade poses in the sector, %d with a free arm solution\n", top, reached);
+  // A quarter of the top: pi r^2 / 4 holds ~3.5 cells of the 8 cm spacing; the directions crowd
+  // towards the rim, where the sector is widest.
+  EXPECT_GE(top, 3);
+  EXPECT_EQ(reached, top);
+}
+
 TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   Fixture f;
   CuttingPoseOptions pose_options;

@@ -78,7 +78,16 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
     const Eigen::Vector3d point = blade.translation();
     if (point.z() < options.min_height) continue;
     const Eigen::Vector3d to_base = (Eigen::Vector3d(0.0, 0.0, point.z()) - point).normalized();
-    if (-blade.linear().col(2).dot(to_base) < std::cos(options.max_facing_angle)) continue;
+    const Eigen::Vector3d normal = -blade.linear().col(2);
+    const bool faces_base = normal.dot(to_base) >= std::cos(options.max_facing_angle);
+    // The crown (surface turned up more than sideways: the top of a ball, the flat top of a
+    // cylinder or box) faces no standoff; the arm reaches over it from the side it lies on. Each
+    // standoff takes the sector within 45 deg of its bearing from the centre, so four standoffs at
+    // right angles (a box's faces or corners) share the crown without cutting any of it twice.
+    const Eigen::Vector3d from_centre(point.x() - target.centre.x(), point.y() - target.centre.y(), 0.0);
+    const bool crown_on_this_side =
+        normal.z() >= normal.head<2>().norm() && from_centre.dot(to_base) >= std::cos(M_PI / 4) * from_centre.norm();
+    if (!faces_base && !crown_on_this_side) continue;
     poses.push_back(blade);
   }
   return poses;

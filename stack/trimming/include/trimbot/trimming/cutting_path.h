@@ -34,7 +34,9 @@ struct CuttingPoseOptions {
 Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eigen::Vector3d& direction,
                               const Eigen::Vector3d& x_hint = Eigen::Vector3d::Zero());
 
-// Blade poses over the target's surface, facing the base at the origin.
+// Blade poses over the target's surface, facing the base at the origin: surface turned at most
+// max_facing_angle from the base, and the crown's sector on the base's side (within 45 deg of its
+// bearing; the crown, surface turned up more than sideways, faces no standoff).
 std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target,
                                             const CuttingPoseOptions& options = {});
 
