@@ -17,6 +17,8 @@ PACKAGES=(
   clang clang-format libclang-rt-dev
   slurmctld slurmd slurm-client munge
   chromium  # the report test opens report.html headless (issue 32)
+  librosbag-storage-dev libstd-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libsensor-msgs-dev libtf2-msgs-dev
+  python3-rosbag  # run.bag: written with rosbag_storage, read back by the bag test
 )
 
 missing=()

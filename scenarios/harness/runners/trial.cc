@@ -14,6 +14,7 @@
 #include "loop/simulated_pose_fixes.h"
 #include "reports/localization_timing.h"
 #include "reports/output_files.h"
+#include "reports/run_bag.h"
 #include "reports/run_timing.h"
 #include "reports/trim_plot.h"
 #include "trimbot/common/atomic_file.h"
@@ -30,6 +31,15 @@ void WriteCostmapImage(const std::string& path, const cv::Mat& layers) {
   image.setTo(cv::Scalar(90, 90, 90), layers == 128);
   image.setTo(cv::Scalar(215, 140, 70), layers == 255);
   WritePng(path, image, true);
+}
+
+// run.bag's fixed frames: the robot as simulated.
+RunBagOptions BagOptionsFor(const sim::Simulator& simulator) {
+  RunBagOptions options;
+  options.T_base_imu = simulator.robot().FramePose("imu_link");
+  for (const auto& camera : simulator.rig().cameras()) options.T_base_cameras.push_back(camera.T_base_camera);
+  options.arm_joint_names = simulator.robot().ArmJointNames();
+  return options;
 }
 
 // `render_for_stack`: the stack asks for the ring cameras it uses, when it uses them.
@@ -79,9 +89,11 @@ void WriteTrimFiles(const std::string& dir, const TrimEvaluator& evaluator, sim:
   }
 }
 
-void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t,
-                 const TrialResult& result) {
+// `bag_seconds`: wall time spent writing run.bag (inside the loop's figures), -1 without one.
+void WriteTiming(const std::string& dir, const RunTiming& run, const stack::StackTimings& t, const TrialResult& result,
+                 double bag_seconds = -1.0) {
   nlohmann::json timing = ToJson(run);
+  if (bag_seconds >= 0.0) timing["run_bag_seconds"] = bag_seconds;
   if (!result.arm_planning_seconds.empty()) timing["arm_planning_seconds"] = result.arm_planning_seconds;
   if (!result.trim_planning_seconds.empty()) timing["trim_planning_seconds"] = result.trim_planning_seconds;
   if (!t.plans.empty()) timing["navigation_planning_seconds"] = t.plans;
@@ -205,8 +217,10 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   options.progress = progress;
   TrimEvaluator trims(simulator, scenario);
   const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
+  RunBag bag(setup.dir + "/run.bag", BagOptionsFor(simulator));
   const auto loop_start = std::chrono::steady_clock::now();
-  const bool finished = RunClosedLoop(simulator, pilot, {&evaluator, &trims}, options);
+  const bool finished = RunClosedLoop(simulator, pilot, {&evaluator, &trims, &bag}, options);
+  bag.Close();
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
   trims.Finish(&result);
@@ -222,7 +236,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   const RunTiming run =
       MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
                     seconds(wall_start, loop_start), seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings, result);
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result, bag.seconds());
   return result;
 }
 
