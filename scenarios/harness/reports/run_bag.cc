@@ -86,6 +86,9 @@ RunBag::RunBag(std::string path, RunBagOptions options)
     : path_(std::move(path)), options_(std::move(options)), bag_(std::make_unique<rosbag::Bag>()) {
   try {
     bag_->open(path_ + ".partial", rosbag::bagmode::Write);
+    // LZ4 chunks (Foxglove, PlotJuggler and rosbag read them): the zero covariances and fixed
+    // frame names of 200 Hz IMU and 50 Hz poses shrink about fivefold.
+    bag_->setCompression(rosbag::compression::LZ4);
   } catch (const std::exception& e) {
     throw InputError(path_ + ".partial", std::string("cannot be written: ") + e.what());
   }
