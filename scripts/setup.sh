@@ -10,7 +10,7 @@ PACKAGES=(
   liburdfdom-dev liburdfdom-headers-dev libconsole-bridge-dev
   libmujoco-dev libqhull-dev libosmesa6-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev libopencv-features2d-dev
-  libopencv-flann-dev
+  libopencv-flann-dev libopencv-videoio-dev  # trial.mp4 (FFmpeg backend)
   liborocos-kdl-dev libfcl-dev liboctomap-dev
   libompl-dev libboost-dev libnanoflann-dev libopen3d-dev libnlopt-cxx-dev libopengv-dev libceres-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3

@@ -2,7 +2,8 @@
 # report.html in a real browser (issue 32): Debian's Chromium, headless, opens the report of
 #   1. a batch of the navigation smoke whose second trial is killed while it runs (it must appear
 #      with its seed and reason) and one of its criteria tightened to fail (shown as failed);
-#   2. a two-point sweep, and 3. the comparison of its two points;
+#   2. a two-point sweep, and 3. the comparison of its two points; 4. a run with --video (trial.mp4,
+#      H.264 in MP4, embedded in the page);
 # each page loads with no console message (the page logs one per image that did not load) and no
 # broken image (data-broken-images="0" on <body> once loaded), and a screenshot of each is saved
 # in OUT for people to look at. Then: the same seed run again gives the same page apart from the
@@ -101,7 +102,19 @@ diff <(strip_timing "$out/again_a/report.html") <(strip_timing "$out/again_b/rep
 grep -q '<h2 id="timing">' "$out/again_a/report.html" || fail "the report has no timing section"
 echo "two runs of one seed: the same report apart from the timing section"
 
-# 5. Bad input: exit 2 naming the file, report.html untouched.
+# 5. --video: trials/000/trial.mp4 (H.264 in MP4, as browsers play it), embedded in the page.
+video="$out/video"
+"$trimbot" run "$scenario" --out "$video" --trials 1 --video > "$out/video.log" 2>&1 || fail "the --video run failed"
+movie="$video/trials/000/trial.mp4"
+[ -s "$movie" ] || fail "--video wrote no $movie"
+[ "$(head -c 8 "$movie" | tail -c 4)" = "ftyp" ] || fail "$movie is not an MP4 file"
+grep -q "avc1" "$movie" || fail "$movie does not hold H.264 (avc1)"
+grep -q '<video controls preload="metadata" src="trials/000/trial.mp4"' "$video/report.html" ||
+  fail "the report does not embed trial.mp4"
+open_in_browser "$video" video
+cmp "$video/summary.json" "$out/again_a/summary.json" || fail "--video changed the trial's result"
+
+# 6. Bad input: exit 2 naming the file, report.html untouched.
 expect_refused() {  # DIR PATTERN
   local text code
   text=$("$trimbot" report "$1" 2>&1)

@@ -385,7 +385,7 @@ void Simulator::Step(SensorOutputs* sensors, GroundTruth* truth) {
   impl_->timings.physics += std::chrono::duration<double>(std::chrono::steady_clock::now() - physics_start).count();
   ++impl_->timings.physics_steps;
   std::optional<RingCapture> capture;
-  if (ring_exposed && impl_->renderer && config_.cameras_on_schedule) {
+  if (ring_exposed && config_.render_cameras && config_.cameras_on_schedule) {
     const int every = config_.ground_truth_every_frames;
     capture = CaptureRing(every > 0 && impl_->frame % every == 0);
   }
@@ -481,7 +481,7 @@ messages::RingRequest Simulator::WholeRing() const {
 RingCapture Simulator::CaptureRing(bool with_ground_truth) { return CaptureRing(WholeRing(), with_ground_truth); }
 
 RingCapture Simulator::CaptureRing(const messages::RingRequest& request, bool with_ground_truth) {
-  if (!impl_->renderer) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
+  if (!config_.render_cameras) throw std::logic_error("CaptureRing: the simulator was configured without cameras");
   for (std::size_t i = 0; i < request.cameras.size(); ++i) {
     const int camera = request.cameras[i];
     if (camera < 0 || camera >= rig_.size() || (i > 0 && camera <= request.cameras[i - 1])) {
@@ -605,11 +605,21 @@ std::vector<ArmContact> Simulator::ArmContacts() const {
 
 cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double distance, double azimuth, double elevation,
                                       int width, int height) {
-  if (!impl_->renderer) throw std::logic_error("RenderExternalView: the simulator was configured without cameras");
-  mj_forward(impl_->world->model(), impl_->world->data());
+  // A plant configured without cameras gets a renderer for views from outside (a trial's video).
+  if (!impl_->renderer) impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config_.frustum_culling);
+  // The view needs the kinematics of the state as it is (after PlaceRobot, say); the run must not
+  // see that forward pass (it moves the solver's warm start: a trial with a video would drift from
+  // one without), so the data is put back as it was.
+  const mjModel* m = impl_->world->model();
+  mjData* d = impl_->world->data();
+  mjData* saved = mj_copyData(nullptr, m, d);
+  mj_forward(m, d);
   DrawCutFoliage();
-  if (impl_->weather_time < 0.0 && impl_->clouds) SetWeatherFor(impl_->world->data()->time);
-  return impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);
+  if (impl_->weather_time < 0.0 && impl_->clouds) SetWeatherFor(d->time);
+  cv::Mat view = impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);
+  mj_copyData(d, m, saved);
+  mj_deleteData(saved);
+  return view;
 }
 
 std::vector<CollisionHull> Simulator::GardenCollisionHulls() const {

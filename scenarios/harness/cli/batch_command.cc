@@ -30,6 +30,8 @@ void AddBatchCommands(Commands& commands) {
   auto* shard_option =
       run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
+  run->add_flag("--video", options->video,
+                "write trials/NNN/trial.mp4: a camera following the robot, cam0 and a top view (slower)");
   run->add_option("--set", options->overrides,
                   "override a scenario or stack parameter, key.path=value (repeatable), e.g. "
                   "--set stack.navigation.follower.cruise_speed=0.3 --set trials=3");

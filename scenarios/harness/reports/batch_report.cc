@@ -20,9 +20,6 @@
 #include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
-namespace {
-
-// ---- JUnit XML --------------------------------------------------------------------------------
 
 std::string XmlEscape(const std::string& text) {
   std::string out;
@@ -61,6 +58,10 @@ std::string XmlEscape(const std::string& text) {
   }
   return out;
 }
+
+namespace {
+
+// ---- JUnit XML --------------------------------------------------------------------------------
 
 std::string FormatSeconds(double seconds) {
   std::ostringstream out;

@@ -20,6 +20,9 @@ struct PlotTrajectory {
 };
 
 void WriteJunitXml(const std::string& path, const BatchSummary& summary);
+// Text for XML or HTML, in elements and attributes: & < > " ' as entities, line breaks and tabs as
+// character references, other control characters as '?'.
+std::string XmlEscape(const std::string& text);
 // `map`: the robot's prior map; `world`: the garden as it really is on the same cells (what the
 // map lacks is drawn in its own colour).
 void WriteTrajectoryPlot(const std::string& path, const garden::OccupancyMap& map, const garden::OccupancyMap& true_map,

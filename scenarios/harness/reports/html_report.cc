@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "evaluation/comparison.h"
+#include "reports/batch_report.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 
@@ -58,29 +59,6 @@ window.addEventListener('load', function () {
 </script>
 )";
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string Number(double value) {
   if (!std::isfinite(value)) return "&ndash;";
   char buffer[32];
@@ -92,9 +70,9 @@ std::string Number(double value) {
 std::string Cell(const json& value) {
   if (value.is_number()) return Number(value.get<double>());
   if (value.is_boolean()) return value.get<bool>() ? "yes" : "no";
-  if (value.is_string()) return Escape(value.get<std::string>());
+  if (value.is_string()) return XmlEscape(value.get<std::string>());
   if (value.is_null()) return "&ndash;";
-  return "<code>" + Escape(value.dump()) + "</code>";
+  return "<code>" + XmlEscape(value.dump()) + "</code>";
 }
 
 std::string NumberCell(const json& value) {
@@ -140,8 +118,8 @@ std::string Figures(const std::vector<std::string>& pictures) {
   std::string html;
   for (const auto& src : pictures) {
     const std::string name = fs::path(src).filename().string();
-    html += "<figure><a href=\"" + Escape(src) + "\"><img src=\"" + Escape(src) + "\" alt=\"" + Escape(name) +
-            "\"></a><figcaption>" + Escape(name) + "</figcaption></figure>\n";
+    html += "<figure><a href=\"" + XmlEscape(src) + "\"><img src=\"" + XmlEscape(src) + "\" alt=\"" + XmlEscape(name) +
+            "\"></a><figcaption>" + XmlEscape(name) + "</figcaption></figure>\n";
   }
   return html;
 }
@@ -158,7 +136,7 @@ std::string ObjectsTable(const json& rows) {
   }
   if (columns.empty()) return "";
   std::string html = "<div class=\"wide\"><table><tr>";
-  for (const auto& c : columns) html += "<th>" + Escape(c) + "</th>";
+  for (const auto& c : columns) html += "<th>" + XmlEscape(c) + "</th>";
   html += "</tr>\n";
   for (const auto& row : rows) {
     html += "<tr>";
@@ -172,7 +150,7 @@ std::string ObjectsTable(const json& rows) {
 std::string KeyValueTable(const json& object) {
   std::string html = "<table>";
   for (const auto& [key, value] : object.items()) {
-    if (!value.is_structured()) html += "<tr><th>" + Escape(key) + "</th>" + NumberCell(value) + "</tr>\n";
+    if (!value.is_structured()) html += "<tr><th>" + XmlEscape(key) + "</th>" + NumberCell(value) + "</tr>\n";
   }
   return html + "</table>\n";
 }
@@ -187,8 +165,8 @@ std::string AnyJson(const json& value, int depth) {
     const std::string inner = rows                ? ObjectsTable(member)
                               : member.is_array() ? "<p>" + Cell(member) + "</p>"
                                                   : AnyJson(member, depth + 1);
-    html += "<details" + std::string(depth == 0 ? " open" : "") + "><summary>" + Escape(key) + "</summary>\n" + inner +
-            "</details>\n";
+    html += "<details" + std::string(depth == 0 ? " open" : "") + "><summary>" + XmlEscape(key) + "</summary>\n" +
+            inner + "</details>\n";
   }
   return html;
 }
@@ -196,7 +174,8 @@ std::string AnyJson(const json& value, int depth) {
 std::string Page(const std::string& title, const std::string& nav, const std::string& body) {
   return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
          "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>" +
-         Escape(title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body data-broken-images=\"unknown\">\n" +
+         XmlEscape(title) + "</title>\n<style>" + kStyle +
+         "</style>\n</head>\n<body data-broken-images=\"unknown\">\n" +
          (nav.empty() ? "" : "<nav>" + nav + "</nav>\n") + body + kImageCheck + "</body>\n</html>\n";
 }
 
@@ -224,9 +203,9 @@ std::string EventsTable(const std::string& path, std::size_t limit) {
     // t,event,goal,detail: the detail is the rest of the line (it may hold commas).
     std::string field;
     for (int column = 0; column < 3 && std::getline(fields, field, ','); ++column)
-      html += (i == 0 ? "<th>" : "<td>") + Escape(field) + (i == 0 ? "</th>" : "</td>");
+      html += (i == 0 ? "<th>" : "<td>") + XmlEscape(field) + (i == 0 ? "</th>" : "</td>");
     std::getline(fields, field);
-    html += (i == 0 ? "<th>" : "<td>") + Escape(field) + (i == 0 ? "</th>" : "</td>");
+    html += (i == 0 ? "<th>" : "<td>") + XmlEscape(field) + (i == 0 ? "</th>" : "</td>");
     html += "</tr>\n";
   }
   if (lines.size() - 1 > limit)
@@ -254,7 +233,7 @@ std::string TrialSection(const std::string& dir, const json& trial) {
                      "): " + Verdict(success, "succeeded", "failed") + " " + Cell(trial.value("status", json("?"))) +
                      "</h3>\n";
   if (!trial.value("message", std::string()).empty())
-    html += "<p><b>Reason:</b> " + Escape(trial["message"].get<std::string>()) + "</p>\n";
+    html += "<p><b>Reason:</b> " + XmlEscape(trial["message"].get<std::string>()) + "</p>\n";
   html += "<details open><summary>figures</summary>" + KeyValueTable(trial) + "</details>\n";
   if (trial.contains("goals") && !trial["goals"].empty())
     html += "<details open><summary>goals</summary>" + ObjectsTable(trial["goals"]) + "</details>\n";
@@ -274,6 +253,9 @@ std::string TrialSection(const std::string& dir, const json& trial) {
     if (!stats.empty())
       html += "<details open><summary>errors against ground truth</summary>" + ObjectsTable(stats) + "</details>\n";
   }
+  if (fs::exists(trial_dir + "/trial.mp4"))
+    html += "<figure><video controls preload=\"metadata\" src=\"trials/" + name +
+            "/trial.mp4\" width=\"1016\"></video><figcaption>trial.mp4</figcaption></figure>\n";
   html += Figures(Pictures(trial_dir, "trials/" + name + "/"));
   html += EventsTable(trial_dir + "/events.csv", 300);
   if (fs::is_directory(trial_dir)) {
@@ -284,7 +266,8 @@ std::string TrialSection(const std::string& dir, const json& trial) {
     }
     std::sort(files.begin(), files.end());
     html += "<p class=\"meta\">files:";
-    for (const auto& f : files) html += " <a href=\"trials/" + name + "/" + Escape(f) + "\">" + Escape(f) + "</a>";
+    for (const auto& f : files)
+      html += " <a href=\"trials/" + name + "/" + XmlEscape(f) + "\">" + XmlEscape(f) + "</a>";
     html += "</p>\n";
   }
   return html + "</section>\n";
@@ -339,7 +322,7 @@ std::string BatchPage(const std::string& dir) {
     const std::string scenario = summary.at("scenario").get<std::string>();
     const bool pass = summary.at("pass").get<bool>();
     const json& trials = summary.at("trials");
-    std::string body = "<h1>" + Escape(scenario) + " " + Verdict(pass) + "</h1>\n<p class=\"meta\">batch of " +
+    std::string body = "<h1>" + XmlEscape(scenario) + " " + Verdict(pass) + "</h1>\n<p class=\"meta\">batch of " +
                        std::to_string(trials.size()) + " of " + Cell(summary.at("trials_planned")) +
                        " planned trials; scenario file " + Cell(summary.value("scenario_file", json(""))) +
                        "; batch seed " + Cell(summary.at("seed")) + " (trial i runs with seed + i)";
@@ -355,9 +338,9 @@ std::string BatchPage(const std::string& dir) {
     for (const MetricEstimate& e : BatchEstimates(summary)) {
       const std::string interval =
           e.n > 0 ? "[" + Number(e.interval.low) + ", " + Number(e.interval.high) + "]" : "&ndash;";
-      body += "<tr><td>" + Escape(e.metric) + "</td><td class=\"num\">" + Number(e.value) + "</td><td class=\"num\">" +
-              interval + "</td><td class=\"num\">" + std::to_string(e.n) + "</td><td>" + Escape(e.unit) +
-              "</td></tr>\n";
+      body += "<tr><td>" + XmlEscape(e.metric) + "</td><td class=\"num\">" + Number(e.value) +
+              "</td><td class=\"num\">" + interval + "</td><td class=\"num\">" + std::to_string(e.n) + "</td><td>" +
+              XmlEscape(e.unit) + "</td></tr>\n";
     }
     body += "</table>\n<details><summary>all batch metrics</summary>" + KeyValueTable(summary.at("metrics")) +
             "</details>\n";
@@ -400,7 +383,7 @@ std::string SweepPage(const std::string& dir) {
   const json sweep = ReadJson(path);
   try {
     const std::string scenario = sweep.at("scenario").get<std::string>();
-    std::string body = "<h1>" + Escape(scenario) + ": sweep</h1>\n<p class=\"meta\">scenario file " +
+    std::string body = "<h1>" + XmlEscape(scenario) + ": sweep</h1>\n<p class=\"meta\">scenario file " +
                        Cell(sweep.value("scenario_file", json(""))) + "; grids " + Cell(sweep.at("grids")) + "</p>\n";
     std::vector<std::string> keys, metrics;
     for (const auto& [key, values] : sweep["grids"].items()) keys.push_back(key);
@@ -412,8 +395,8 @@ std::string SweepPage(const std::string& dir) {
     body +=
         "<h2 id=\"points\">Points</h2>\n<p class=\"meta\">value [95 % interval] over the point's "
         "trials</p>\n<div class=\"wide\"><table><tr><th>point</th>";
-    for (const auto& k : keys) body += "<th>" + Escape(k) + "</th>";
-    for (const auto& m : metrics) body += "<th>" + Escape(m) + "</th>";
+    for (const auto& k : keys) body += "<th>" + XmlEscape(k) + "</th>";
+    for (const auto& m : metrics) body += "<th>" + XmlEscape(m) + "</th>";
     body += "</tr>\n";
     for (const auto& point : sweep["points"]) {
       const std::string name = TrialName(point.at("index").get<int>());
@@ -460,13 +443,13 @@ std::string ComparisonPage(const std::string& dir) {
               Cell(m.value("unit", json(""))) + "</td>" + NumberCell(m.at("baseline")) + NumberCell(m.at("candidate")) +
               "<td class=\"num\">" + Cell(m.at("delta")) + " [" + Cell(interval.at(0)) + ", " + Cell(interval.at(1)) +
               "]</td>" + NumberCell(m.at("p_worse")) + NumberCell(m.at("p_better")) + "<td>" +
-              Cell(m.value("test", json(""))) + "</td><td class=\"verdict\">" + Escape(verdict) + "</td></tr>\n";
+              Cell(m.value("test", json(""))) + "</td><td class=\"verdict\">" + XmlEscape(verdict) + "</td></tr>\n";
     }
     body += "</table>\n";
     if (comparison.contains("power") && !comparison["power"].empty())
       body += "<h2 id=\"power\">Trials needed to see a change</h2>\n" + ObjectsTable(comparison["power"]);
     body += Figures(Pictures(dir, ""));
-    return Page(Escape(comparison["scenario"].get<std::string>()) + ": comparison", "", body);
+    return Page(XmlEscape(comparison["scenario"].get<std::string>()) + ": comparison", "", body);
   } catch (const json::exception& e) {
     throw InputError(path, std::string("is not a comparison: ") + e.what());
   }
@@ -479,7 +462,7 @@ std::string SuitePage(const std::string& dir) {
   json suite = ReadJson(path);
   try {
     const std::string name = suite.at("suite").get<std::string>();
-    std::string body = "<h1>" + Escape(name) + ": suite";
+    std::string body = "<h1>" + XmlEscape(name) + ": suite";
     if (fs::exists(dir + "/summary.json")) {
       const json summary = ReadJson(dir + "/summary.json");
       try {
@@ -512,7 +495,7 @@ std::string GenericPage(const std::string& dir, const std::string& file, const s
       result.value("scenario", result.value("name", fs::path(dir).filename().string())) + ": " + what;
   return Page(
       title, "",
-      "<h1>" + Escape(title) + "</h1>\n" + AnyJson(result, 0) + "<h2>Plots</h2>\n" + Figures(Pictures(dir, "")));
+      "<h1>" + XmlEscape(title) + "</h1>\n" + AnyJson(result, 0) + "<h2>Plots</h2>\n" + Figures(Pictures(dir, "")));
 }
 
 }  // namespace

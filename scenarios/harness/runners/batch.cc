@@ -376,7 +376,7 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
   fs::remove_all(trial.dir);
   fs::create_directories(trial.dir);
   const TrialSetup setup{&scenario, &prepared, options.paths, options.out_dir + "/map/map.yaml",
-                         trial.dir, index,     trial.seed};
+                         trial.dir, index,     trial.seed,    options.video};
   std::cout.flush();
   trial.started = Clock::now();
   trial.pid = fork();

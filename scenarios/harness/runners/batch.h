@@ -43,6 +43,7 @@ struct BatchOptions {
   bool keep_worlds = false;            // keep each trial's composed MuJoCo prepared (large textures)
   std::vector<std::string> overrides;  // --set key.path=value, applied to the scenario file
   bool quiet = false;                  // no per-trial lines or report listing (sweeps, tuning)
+  bool video = false;                  // each trial writes trial.mp4
 };
 
 // A trial's folder in a batch's output folder: <out>/trials/NNN.

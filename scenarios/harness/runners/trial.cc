@@ -16,6 +16,7 @@
 #include "reports/output_files.h"
 #include "reports/run_bag.h"
 #include "reports/run_timing.h"
+#include "reports/trial_video.h"
 #include "reports/trim_plot.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/sim/simulator.h"
@@ -218,9 +219,16 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   TrimEvaluator trims(simulator, scenario);
   const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
   RunBag bag(setup.dir + "/run.bag", BagOptionsFor(simulator));
+  std::vector<Observer*> observers{&evaluator, &trims, &bag};
+  std::optional<TrialVideo> video;
+  if (setup.video) {
+    video.emplace(setup.dir + "/trial.mp4", simulator, setup.prepared->prior_map);
+    observers.push_back(&*video);
+  }
   const auto loop_start = std::chrono::steady_clock::now();
-  const bool finished = RunClosedLoop(simulator, pilot, {&evaluator, &trims, &bag}, options);
+  const bool finished = RunClosedLoop(simulator, pilot, observers, options);
   bag.Close();
+  if (video) video->Close();
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
   trims.Finish(&result);

@@ -24,6 +24,7 @@ struct TrialSetup {
   std::string dir;       // this trial's output folder
   int index = 0;
   std::uint64_t seed = 0;
+  bool video = false;  // write trial.mp4 (reports/trial_video.h)
 };
 
 // Runs the trial; `progress(simulated_seconds)` is called about once per simulated second.
