@@ -39,6 +39,7 @@ expected_types = {
     "/cmd_vel": "geometry_msgs/Twist",
     "/cam0/image/compressed": "sensor_msgs/CompressedImage",
     "/events": "std_msgs/String",
+    "/costmap": "nav_msgs/OccupancyGrid",
 }
 for topic, msg_type in expected_types.items():
     check(topic in topics and topics[topic].msg_type == msg_type, f"{topic} holds {msg_type}")
@@ -52,7 +53,7 @@ def near_rate(topic, rate_hz):
 
 
 near_rate("/imu", parameters["imu"]["rate_hz"])
-for topic in ("/ground_truth/pose", "/ekf/pose", "/wheel_odometry", "/tf"):
+for topic in ("/ground_truth/pose", "/ekf/pose", "/wheel_odometry"):
     near_rate(topic, 50.0)  # the bag's pose rate
 frames = count.get("/cam0/image/compressed", 0)
 check(0 < frames <= parameters["cameras"]["rate_hz"] * duration + 1,
@@ -68,6 +69,25 @@ for _, message, _ in bag.read_messages(topics=["/tf_static"]):
         static[(t.header.frame_id, t.child_frame_id)] = t
 check(("base_link", "cam0_optical_frame") in static, "/tf_static: base_link -> cam0_optical_frame")
 check(("base_link", "imu_link") in static, "/tf_static: base_link -> imu_link")
+near_rate("/costmap", 1.0)
+grid = next(bag.read_messages(topics=["/costmap"]))[1]
+check(grid.info.width * grid.info.height == len(grid.data) and 100 in grid.data and 0 in grid.data,
+      f"/costmap: a {grid.info.width} x {grid.info.height} grid at {grid.info.resolution} m with obstacles and free cells")
+
+# The arm: base_link -> arm_link_base (static) -> arm_link_1 ... arm_link_6 (/tf at each joint
+# state) -> arm_end_effector (static).
+arm_links = set()
+for _, message, _ in bag.read_messages(topics=["/tf"]):
+    for t in message.transforms:
+        if t.child_frame_id.startswith("arm_link_"):
+            arm_links.add((t.header.frame_id, t.child_frame_id))
+chain = [("base_link", "arm_link_base")] + [
+    (("arm_link_base" if k == 1 else f"arm_link_{k - 1}"), f"arm_link_{k}") for k in range(1, 7)] + [
+    ("arm_link_6", "arm_end_effector")]
+found = [link in arm_links or link in static for link in chain]
+check(all(found), "the arm's chain base_link -> arm_link_base -> arm_link_1..6 -> arm_end_effector: " +
+      ", ".join(f"{a}->{b}" for (a, b), ok in zip(chain, found) if not ok) if not all(found) else
+      "the arm's chain base_link -> arm_link_base -> arm_link_1..6 -> arm_end_effector is complete")
 
 
 def planar(translation, rotation):
@@ -98,7 +118,8 @@ for _, message, _ in bag.read_messages(topics=["/tf"]):
     p = e.pose.pose
     ex, ey, eyaw = planar(p.position, p.orientation)
     worst = max(worst, math.hypot(x - ex, y - ey), abs(math.remainder(yaw - eyaw, 2 * math.pi)))
-check(chains == count.get("/tf", -1), f"/tf: map -> odom -> base_link in all {chains} messages")
+check(chains == count.get("/tf", -1) - count.get("/joint_states", 0) and abs(chains - 50.0 * duration) <= 0.01 * 50.0 * duration + 2,
+      f"/tf: map -> odom -> base_link at 50 Hz, in all {chains} messages but the arm's")
 check(compared == chains and worst < 1e-6,
       f"map -> odom -> base_link is the EKF's pose at all {compared} stamps (worst {worst:.2e})")
 

@@ -3,6 +3,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/Twist.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -84,6 +85,7 @@ geometry_msgs::PoseWithCovarianceStamped PlanarPoseMessage(double t, const Pose2
 
 RunBag::RunBag(std::string path, RunBagOptions options)
     : path_(std::move(path)), options_(std::move(options)), bag_(std::make_unique<rosbag::Bag>()) {
+  if (options_.robot != nullptr) arm_joints_ = options_.robot->ArmJointNames();
   try {
     bag_->open(path_ + ".partial", rosbag::bagmode::Write);
     // LZ4 chunks (Foxglove, PlotJuggler and rosbag read them): the zero covariances and fixed
@@ -107,19 +109,10 @@ void RunBag::Observe(const StepView& step) {
 
 void RunBag::Record(const StepView& step) {
   const double t = step.time;
-  if (!static_written_) {
-    tf2_msgs::TFMessage fixed;
-    fixed.transforms.push_back(TransformMessage(t, "base_link", "imu_link", options_.T_base_imu));
-    for (std::size_t k = 0; k < options_.T_base_cameras.size(); ++k) {
-      fixed.transforms.push_back(
-          TransformMessage(t, "base_link", "cam" + std::to_string(k) + "_optical_frame", options_.T_base_cameras[k]));
-    }
-    bag_->write("/tf_static", Stamp(t), fixed);
-    ++messages_;
-    static_written_ = true;
-  }
+  if (!static_written_) RecordStatic(t);
   RecordSensors(step);
   RecordStack(step);
+  if (options_.costmap && t + 1e-9 >= next_costmap_) RecordCostmap(t);
   if (step.commands.base && t >= next_command_) {
     geometry_msgs::Twist twist;
     twist.linear.x = step.commands.base->linear;
@@ -176,10 +169,19 @@ void RunBag::RecordSensors(const StepView& step) {
   for (const auto& joints : step.sensors.arm_joints) {
     sensor_msgs::JointState state;
     state.header.stamp = Stamp(joints.stamp);
-    state.name = options_.arm_joint_names;
+    state.name = arm_joints_;
     state.position.assign(joints.position.begin(), joints.position.end());
     state.velocity.assign(joints.velocity.begin(), joints.velocity.end());
     bag_->write("/joint_states", state.header.stamp, state);
+    ++messages_;
+    if (options_.robot == nullptr) continue;
+    tf2_msgs::TFMessage arm;
+    for (std::size_t j = 0; j < arm_joints_.size() && j < joints.position.size(); ++j) {
+      const auto joint = options_.robot->urdf().getJoint(arm_joints_[j]);
+      arm.transforms.push_back(TransformMessage(joints.stamp, joint->parent_link_name, joint->child_link_name,
+                                                robot::RobotDescription::JointTransform(*joint, joints.position[j])));
+    }
+    bag_->write("/tf", Stamp(joints.stamp), arm);
     ++messages_;
   }
   if (options_.images && step.sensors.ring) {
@@ -222,6 +224,57 @@ void RunBag::RecordStack(const StepView& step) {
     ++messages_;
     last_fix_ = std::max(last_fix_, applied.fix.stamp);
   }
+}
+
+// The robot's fixed frames, once.
+void RunBag::RecordStatic(double t) {
+  tf2_msgs::TFMessage fixed;
+  for (std::size_t k = 0; k < options_.T_base_cameras.size(); ++k) {
+    fixed.transforms.push_back(
+        TransformMessage(t, "base_link", "cam" + std::to_string(k) + "_optical_frame", options_.T_base_cameras[k]));
+  }
+  if (options_.robot != nullptr) {
+    const robot::RobotDescription& robot = *options_.robot;
+    fixed.transforms.push_back(TransformMessage(t, "base_link", "imu_link", robot.FramePose("imu_link")));
+    if (!arm_joints_.empty()) {
+      const auto first = robot.urdf().getJoint(arm_joints_.front());
+      const auto last = robot.urdf().getJoint(arm_joints_.back());
+      fixed.transforms.push_back(
+          TransformMessage(t, "base_link", first->parent_link_name, robot.FramePose(first->parent_link_name)));
+      fixed.transforms.push_back(TransformMessage(
+          t, last->child_link_name, robot::RobotFrames::kEndEffector,
+          robot.FramePose(last->child_link_name).inverse() * robot.FramePose(robot::RobotFrames::kEndEffector)));
+    }
+  }
+  bag_->write("/tf_static", Stamp(t), fixed);
+  ++messages_;
+  static_written_ = true;
+}
+
+// The navigator's costmap as an occupancy grid (row 0 at the bottom, REP-103's y up).
+void RunBag::RecordCostmap(double t) {
+  next_costmap_ = (std::floor(t * options_.costmap_rate + 1e-6) + 1.0) / options_.costmap_rate;
+  const cv::Mat layers = options_.costmap();
+  if (layers.empty()) return;
+  nav_msgs::OccupancyGrid grid;
+  grid.header.stamp = Stamp(t);
+  grid.header.frame_id = "map";
+  grid.info.map_load_time = Stamp(t);
+  grid.info.resolution = static_cast<float>(options_.costmap_cells.resolution);
+  grid.info.width = static_cast<std::uint32_t>(layers.cols);
+  grid.info.height = static_cast<std::uint32_t>(layers.rows);
+  grid.info.origin.position.x = options_.costmap_cells.origin.x();
+  grid.info.origin.position.y = options_.costmap_cells.origin.y();
+  grid.info.origin.orientation.w = 1.0;
+  grid.data.resize(static_cast<std::size_t>(layers.rows) * static_cast<std::size_t>(layers.cols));
+  for (int row = 0; row < layers.rows; ++row) {
+    const std::uint8_t* cells = layers.ptr<std::uint8_t>(layers.rows - 1 - row);
+    for (int col = 0; col < layers.cols; ++col)
+      grid.data[static_cast<std::size_t>(row) * static_cast<std::size_t>(layers.cols) + static_cast<std::size_t>(col)] =
+          cells[col] > 0 ? 100 : 0;
+  }
+  bag_->write("/costmap", grid.header.stamp, grid);
+  ++messages_;
 }
 
 void RunBag::Close() {

@@ -34,12 +34,14 @@ void WriteCostmapImage(const std::string& path, const cv::Mat& layers) {
   WritePng(path, image, true);
 }
 
-// run.bag's fixed frames: the robot as simulated.
-RunBagOptions BagOptionsFor(const sim::Simulator& simulator) {
+// run.bag's frames (the robot as simulated) and the navigator's costmap.
+RunBagOptions BagOptionsFor(const sim::Simulator& simulator, const stack::RobotStack& robot,
+                            const garden::OccupancyMap& map) {
   RunBagOptions options;
-  options.T_base_imu = simulator.robot().FramePose("imu_link");
+  options.robot = &simulator.robot();
   for (const auto& camera : simulator.rig().cameras()) options.T_base_cameras.push_back(camera.T_base_camera);
-  options.arm_joint_names = simulator.robot().ArmJointNames();
+  options.costmap = [&robot] { return robot.CostmapLayers(); };
+  options.costmap_cells = map;
   return options;
 }
 
@@ -218,7 +220,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   options.progress = progress;
   TrimEvaluator trims(simulator, scenario);
   const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
-  RunBag bag(setup.dir + "/run.bag", BagOptionsFor(simulator));
+  RunBag bag(setup.dir + "/run.bag", BagOptionsFor(simulator, robot, setup.prepared->prior_map));
   std::vector<Observer*> observers{&evaluator, &trims, &bag};
   std::optional<TrialVideo> video;
   if (setup.video) {
