@@ -30,6 +30,7 @@ void AddBatchCommands(Commands& commands) {
   auto* shard_option =
       run->add_option("--shard", *shard, "run only shard i of n (trials with index % n == i), e.g. 0/4");
   run->add_flag("--keep-worlds", options->keep_worlds, "keep each trial's composed MuJoCo world");
+  run->add_flag("!--no-bag", options->bag, "write no trials/NNN/run.bag (about 65 kB per simulated second)");
   run->add_flag("--video", options->video,
                 "write trials/NNN/trial.mp4: a camera following the robot, cam0 and a top view (slower)");
   run->add_option("--set", options->overrides,

@@ -375,8 +375,8 @@ RunningTrial StartTrial(const BatchOptions& options, const Scenario& scenario, c
   trial.dir = TrialDir(options.out_dir, index);
   fs::remove_all(trial.dir);
   fs::create_directories(trial.dir);
-  const TrialSetup setup{&scenario, &prepared, options.paths, options.out_dir + "/map/map.yaml",
-                         trial.dir, index,     trial.seed,    options.video};
+  const TrialSetup setup{&scenario,  &prepared,     options.paths, options.out_dir + "/map/map.yaml", trial.dir, index,
+                         trial.seed, options.video, options.bag};
   std::cout.flush();
   trial.started = Clock::now();
   trial.pid = fork();

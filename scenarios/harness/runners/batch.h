@@ -44,6 +44,7 @@ struct BatchOptions {
   std::vector<std::string> overrides;  // --set key.path=value, applied to the scenario file
   bool quiet = false;                  // no per-trial lines or report listing (sweeps, tuning)
   bool video = false;                  // each trial writes trial.mp4
+  bool bag = true;                     // each trial writes run.bag
 };
 
 // A trial's folder in a batch's output folder: <out>/trials/NNN.

@@ -220,8 +220,12 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   options.progress = progress;
   TrimEvaluator trims(simulator, scenario);
   const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
-  RunBag bag(setup.dir + "/run.bag", BagOptionsFor(simulator, robot, setup.prepared->prior_map));
-  std::vector<Observer*> observers{&evaluator, &trims, &bag};
+  std::optional<RunBag> bag;
+  std::vector<Observer*> observers{&evaluator, &trims};
+  if (setup.bag) {
+    bag.emplace(setup.dir + "/run.bag", BagOptionsFor(simulator, robot, setup.prepared->prior_map));
+    observers.push_back(&*bag);
+  }
   std::optional<TrialVideo> video;
   if (setup.video) {
     video.emplace(setup.dir + "/trial.mp4", simulator, setup.prepared->prior_map);
@@ -229,7 +233,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   }
   const auto loop_start = std::chrono::steady_clock::now();
   const bool finished = RunClosedLoop(simulator, pilot, observers, options);
-  bag.Close();
+  if (bag) bag->Close();
   if (video) video->Close();
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
@@ -246,7 +250,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   const RunTiming run =
       MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
                     seconds(wall_start, loop_start), seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings, result, bag.seconds());
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result, bag ? bag->seconds() : -1.0);
   return result;
 }
 

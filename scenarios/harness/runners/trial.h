@@ -25,6 +25,7 @@ struct TrialSetup {
   int index = 0;
   std::uint64_t seed = 0;
   bool video = false;  // write trial.mp4 (reports/trial_video.h)
+  bool bag = true;     // write run.bag (reports/run_bag.h)
 };
 
 // Runs the trial; `progress(simulated_seconds)` is called about once per simulated second.
