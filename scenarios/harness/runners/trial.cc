@@ -45,6 +45,25 @@ RunBagOptions BagOptionsFor(const sim::Simulator& simulator, const stack::RobotS
   return options;
 }
 
+// What a trial records beside its evaluation, as the setup asks: run.bag, trial.mp4.
+struct TrialRecorders {
+  std::optional<RunBag> bag;
+  std::optional<TrialVideo> video;
+
+  TrialRecorders(const TrialSetup& setup, sim::Simulator& simulator, const stack::RobotStack& robot) {
+    if (setup.bag) bag.emplace(setup.dir + "/run.bag", BagOptionsFor(simulator, robot, setup.prepared->prior_map));
+    if (setup.video) video.emplace(setup.dir + "/trial.mp4", simulator, setup.prepared->prior_map);
+  }
+  void AddTo(std::vector<Observer*>* observers) {
+    if (bag) observers->push_back(&*bag);
+    if (video) observers->push_back(&*video);
+  }
+  void Close() {
+    if (bag) bag->Close();
+    if (video) video->Close();
+  }
+};
+
 // `render_for_stack`: the stack asks for the ring cameras it uses, when it uses them.
 sim::SimulatorConfig PlantFor(const TrialSetup& setup, bool render_for_stack) {
   const Scenario& scenario = *setup.scenario;
@@ -220,21 +239,12 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   options.progress = progress;
   TrimEvaluator trims(simulator, scenario);
   const std::vector<cv::Mat> trim_views = RenderTrimBushes(simulator, scenario);
-  std::optional<RunBag> bag;
+  TrialRecorders recorders(setup, simulator, robot);
   std::vector<Observer*> observers{&evaluator, &trims};
-  if (setup.bag) {
-    bag.emplace(setup.dir + "/run.bag", BagOptionsFor(simulator, robot, setup.prepared->prior_map));
-    observers.push_back(&*bag);
-  }
-  std::optional<TrialVideo> video;
-  if (setup.video) {
-    video.emplace(setup.dir + "/trial.mp4", simulator, setup.prepared->prior_map);
-    observers.push_back(&*video);
-  }
+  recorders.AddTo(&observers);
   const auto loop_start = std::chrono::steady_clock::now();
   const bool finished = RunClosedLoop(simulator, pilot, observers, options);
-  if (bag) bag->Close();
-  if (video) video->Close();
+  recorders.Close();
 
   evaluator.Finish(finished, scenario.time_limit, robot.telemetry(), &result);
   trims.Finish(&result);
@@ -250,7 +260,7 @@ TrialResult RunTrial(const TrialSetup& setup, const std::function<void(double)>&
   const RunTiming run =
       MakeRunTiming(seconds(wall_start, now), result.simulated_seconds, simulator.timings(), &robot.telemetry().timings,
                     seconds(wall_start, loop_start), seconds(report_start, now));
-  WriteTiming(setup.dir, run, robot.telemetry().timings, result, bag ? bag->seconds() : -1.0);
+  WriteTiming(setup.dir, run, robot.telemetry().timings, result, recorders.bag ? recorders.bag->seconds() : -1.0);
   return result;
 }
 
