@@ -608,17 +608,21 @@ cv::Mat Simulator::RenderExternalView(const Eigen::Vector3d& lookat, double dist
   // A plant configured without cameras gets a renderer for views from outside (a trial's video).
   if (!impl_->renderer) impl_->renderer = std::make_unique<RingRenderer>(*impl_->world, rig_, config_.frustum_culling);
   // The view needs the kinematics of the state as it is (after PlaceRobot, say); the run must not
-  // see that forward pass (it moves the solver's warm start: a trial with a video would drift from
-  // one without), so the data is put back as it was.
+  // see that forward pass (it changes the data the next step starts from: with it, a trial with a
+  // video drifted from the same trial without, measured on the navigation smoke), so the data is
+  // put back as it was.
   const mjModel* m = impl_->world->model();
   mjData* d = impl_->world->data();
-  mjData* saved = mj_copyData(nullptr, m, d);
+  // Put back however the view ends (a throw included).
+  const auto put_back = [m, d](mjData* saved) {
+    mj_copyData(d, m, saved);
+    mj_deleteData(saved);
+  };
+  const std::unique_ptr<mjData, decltype(put_back)> saved(mj_copyData(nullptr, m, d), put_back);
   mj_forward(m, d);
   DrawCutFoliage();
   if (impl_->weather_time < 0.0 && impl_->clouds) SetWeatherFor(d->time);
   cv::Mat view = impl_->renderer->RenderExternalView(lookat, distance, azimuth, elevation, width, height);
-  mj_copyData(d, m, saved);
-  mj_deleteData(saved);
   return view;
 }
 

@@ -68,6 +68,9 @@ std::string Number(double value) {
 
 // A JSON scalar as table text; arrays and objects as compact JSON.
 std::string Cell(const json& value) {
+  // Seeds and counts exactly (a seed printed as 2.024e+07 names no trial).
+  if (value.is_number_unsigned()) return std::to_string(value.get<std::uint64_t>());
+  if (value.is_number_integer()) return std::to_string(value.get<std::int64_t>());
   if (value.is_number()) return Number(value.get<double>());
   if (value.is_boolean()) return value.get<bool>() ? "yes" : "no";
   if (value.is_string()) return XmlEscape(value.get<std::string>());
@@ -273,10 +276,8 @@ std::string TrialSection(const std::string& dir, const json& trial) {
   return html + "</section>\n";
 }
 
-std::string TimingSection(const std::string& dir) {
-  const std::string path = dir + "/timing.json";
-  if (!fs::exists(path)) return "";
-  const json timing = ReadJson(path);
+// The timing section: wall-clock figures, which differ from run to run.
+std::string TimingTables(const std::string& dir, const json& timing) {
   std::string html = "<h2 id=\"timing\">Timing <span class=\"wall\">(wall clock: differs run to run)</span></h2>\n";
   if (timing.contains("mean_wall_seconds"))
     html += "<p>Mean wall time per trial: " + Number(timing["mean_wall_seconds"].get<double>()) + " s";
@@ -293,6 +294,17 @@ std::string TimingSection(const std::string& dir) {
     if (timing.contains(plans)) html += "<p>" + std::string(plans) + "</p>" + KeyValueTable(timing[plans]);
   }
   return html;
+}
+
+std::string TimingSection(const std::string& dir) {
+  const std::string path = dir + "/timing.json";
+  if (!fs::exists(path)) return "";
+  const json timing = ReadJson(path);
+  try {
+    return TimingTables(dir, timing);
+  } catch (const json::exception& e) {
+    throw InputError(path, std::string("is not a batch's timing: ") + e.what());
+  }
 }
 
 // The criteria of a batch summary (summary.json), pass/fail coloured.
@@ -449,7 +461,7 @@ std::string ComparisonPage(const std::string& dir) {
     if (comparison.contains("power") && !comparison["power"].empty())
       body += "<h2 id=\"power\">Trials needed to see a change</h2>\n" + ObjectsTable(comparison["power"]);
     body += Figures(Pictures(dir, ""));
-    return Page(XmlEscape(comparison["scenario"].get<std::string>()) + ": comparison", "", body);
+    return Page(comparison["scenario"].get<std::string>() + ": comparison", "", body);
   } catch (const json::exception& e) {
     throw InputError(path, std::string("is not a comparison: ") + e.what());
   }
@@ -459,7 +471,7 @@ std::string ComparisonPage(const std::string& dir) {
 // with each garden's own batch report, and the rest of suite.json as it stands.
 std::string SuitePage(const std::string& dir) {
   const std::string path = dir + "/suite.json";
-  json suite = ReadJson(path);
+  const json suite = ReadJson(path);
   try {
     const std::string name = suite.at("suite").get<std::string>();
     std::string body = "<h1>" + XmlEscape(name) + ": suite";
@@ -473,14 +485,25 @@ std::string SuitePage(const std::string& dir) {
     } else {
       body += "</h1>\n";
     }
-    json gardens = suite.at("gardens");
-    for (std::size_t i = 0; i < gardens.size(); ++i) {
-      const std::string garden = "gardens/" + TrialName(static_cast<int>(i));
-      if (fs::exists(dir + "/" + garden + "/report.html")) gardens[i]["report"] = garden + "/report.html";
-    }
+    const json& gardens = suite.at("gardens");
     body += "<h2 id=\"gardens\">Gardens</h2>\n" + ObjectsTable(gardens);
-    suite.erase("gardens");
-    body += "<h2>Figures</h2>\n" + AnyJson(suite, 0) + Figures(Pictures(dir, ""));
+    std::string links;
+    for (std::size_t i = 0; i < gardens.size(); ++i) {
+      const std::string report = "gardens/" + TrialName(static_cast<int>(i)) + "/batch/report.html";
+      if (fs::exists(dir + "/" + report))
+        links += " <a href=\"" + report + "\">" + TrialName(static_cast<int>(i)) + "</a>";
+    }
+    if (!links.empty()) body += "<p>Each garden's batch report:" + links + "</p>\n";
+    json rest = suite;
+    rest.erase("gardens");
+    const json planning = rest.value("navigation_planning_ms", json());  // wall clock: its own section
+    rest.erase("navigation_planning_ms");
+    body += "<h2>Figures</h2>\n" + AnyJson(rest, 0) + Figures(Pictures(dir, ""));
+    if (!planning.is_null())
+      body +=
+          "<h2 id=\"timing\">Timing <span class=\"wall\">(wall clock: differs run to run)</span></h2>\n"
+          "<p>navigation_planning_ms</p>" +
+          KeyValueTable(planning);
     return Page(name + ": suite", "", body);
   } catch (const json::exception& e) {
     throw InputError(path, std::string("is not a suite result: ") + e.what());
@@ -491,8 +514,12 @@ std::string SuitePage(const std::string& dir) {
 std::string GenericPage(const std::string& dir, const std::string& file, const std::string& what) {
   const json result = ReadJson(dir + "/" + file);
   if (!result.is_object()) throw InputError(dir + "/" + file, "is not a JSON object");
-  const std::string title =
-      result.value("scenario", result.value("name", fs::path(dir).filename().string())) + ": " + what;
+  std::string title;
+  try {
+    title = result.value("scenario", result.value("name", fs::path(dir).filename().string())) + ": " + what;
+  } catch (const json::exception& e) {
+    throw InputError(dir + "/" + file, std::string("names its scenario with no string: ") + e.what());
+  }
   return Page(
       title, "",
       "<h1>" + XmlEscape(title) + "</h1>\n" + AnyJson(result, 0) + "<h2>Plots</h2>\n" + Figures(Pictures(dir, "")));

@@ -97,8 +97,12 @@ RunBag::RunBag(std::string path, RunBagOptions options)
 }
 
 RunBag::~RunBag() {
-  // A bag never closed (the trial threw) stays .partial: incomplete, and named so.
-  if (bag_) bag_->close();
+  // A bag never closed (the trial threw) stays .partial: incomplete, and named so. Closing it
+  // may fail (a full disk); the trial's own error is the one to report.
+  try {
+    if (bag_) bag_->close();
+  } catch (const std::exception&) {
+  }
 }
 
 void RunBag::Observe(const StepView& step) {
@@ -113,13 +117,13 @@ void RunBag::Record(const StepView& step) {
   RecordSensors(step);
   RecordStack(step);
   if (options_.costmap && t + 1e-9 >= next_costmap_) RecordCostmap(t);
-  if (step.commands.base && t >= next_command_) {
+  if (step.commands.base && t + 1e-9 >= next_command_) {
     geometry_msgs::Twist twist;
     twist.linear.x = step.commands.base->linear;
     twist.angular.z = step.commands.base->angular;
     bag_->write("/cmd_vel", Stamp(t), twist);
     ++messages_;
-    next_command_ = t + 1.0 / options_.pose_rate;
+    next_command_ = (std::floor(t * options_.pose_rate + 1e-6) + 1.0) / options_.pose_rate;
   }
   if (t + 1e-9 < next_pose_) return;
   // On the rate's grid (k / pose_rate), where the trial's TUM files sample the ground truth too.
@@ -279,8 +283,8 @@ void RunBag::RecordCostmap(double t) {
 
 void RunBag::Close() {
   const auto begin = std::chrono::steady_clock::now();
-  bag_->close();
-  bag_.reset();
+  const std::unique_ptr<rosbag::Bag> bag = std::move(bag_);  // closed once, even if it throws
+  bag->close();
   std::filesystem::rename(path_ + ".partial", path_);
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
 }

@@ -15,7 +15,7 @@
 //   /imu                        sensor_msgs/Imu, imu_link, every sample
 //   /joint_states               sensor_msgs/JointState, the arm's joints, every sample
 //   /visual_localization/fix    geometry_msgs/PoseWithCovarianceStamped, map, each fix the EKF got
-//   /cmd_vel                    geometry_msgs/Twist, each base command
+//   /cmd_vel                    geometry_msgs/Twist, the base's command, at most at pose_rate
 //   /cam0/image/compressed      sensor_msgs/CompressedImage (JPEG), the ring's cam0 each frame the
 //                               stack asked for, downscaled (optional: images = false)
 //   /events                     std_msgs/String, the navigator's events ("goal_reached 3: ...")

@@ -227,6 +227,16 @@ void LogPlanTimes(std::ostream& log, const std::string& what, const json& plans)
       << " ms, max " << plans["max"].get<double>() << " ms over " << plans["plans"].get<int>() << " plans\n";
 }
 
+// report.html of the batch in `out`. The batch's results stand without the page: a page that
+// cannot be built is reported, and the exit code stays the criteria's.
+void WriteReportPage(const std::string& out) {
+  try {
+    WriteHtmlReport(out);
+  } catch (const std::exception& e) {
+    std::cerr << "report.html not written: " << e.what() << "\n";
+  }
+}
+
 // Summary, JUnit and plots of a set of trial results, written into `out`; returns the exit code.
 // `goals`: the goals' positions as planned (a bush goal: its surveyed centre), for the plot.
 // `final_out`: the folder the log names (merge builds the reports beside it and swaps them in).
@@ -287,7 +297,7 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
     WriteBushErrorPlot(out + "/bush_errors.png", scenario.name + ": bush approach errors against ground truth",
                        results);
   }
-  WriteHtmlReport(out);
+  WriteReportPage(out);
 
   log << "\n" << scenario.name << ": " << results.size() << " of " << trials_planned << " trials\n";
   for (const auto& r : results) log << "  " << OneLine(r) << "\n";
