@@ -18,7 +18,7 @@ PACKAGES=(
   slurmctld slurmd slurm-client munge
   chromium  # the report test opens report.html headless (issue 32)
   librosbag-storage-dev libstd-msgs-dev libgeometry-msgs-dev libnav-msgs-dev libsensor-msgs-dev libtf2-msgs-dev
-  python3-rosbag  # run.bag: written with rosbag_storage, read back by the bag test
+  python3-rosbag python3-yaml  # run.bag: written with rosbag_storage, read back by the bag test
 )
 
 missing=()
