@@ -26,6 +26,7 @@ void AddDriveCommand(Commands& commands) {
       ->check(CLI::Range(0, 16));
   drive->add_flag("--no-cameras", *no_cameras, "do not render the ring");
   drive->add_flag("--quiet", options->quiet, "no progress display");
+  drive->add_flag("--video", options->video, "write drive.mp4: a camera following the robot, cam0 and a top view");
   commands.OnRun(drive, [=, &commands] {
     options->paths = commands.paths();
     if (seed_option->count() > 0) options->seed = *seed;

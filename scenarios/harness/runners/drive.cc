@@ -7,12 +7,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
 #include "loop/closed_loop.h"
 #include "loop/drive_plan.h"
 #include "loop/pilots.h"
 #include "reports/run_log.h"
 #include "reports/run_timing.h"
+#include "reports/trial_video.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/garden/garden.h"
 #include "trimbot/sim/simulator.h"
@@ -108,6 +110,8 @@ int RunDrive(const DriveOptions& options) {
   ProgressLine progress(duration, log);
   std::vector<Observer*> observers{&log};
   if (!options.quiet) observers.push_back(&progress);
+  std::optional<TrialVideo> video;  // the top view without a map: a drive has none
+  if (options.video) observers.push_back(&video.emplace(out + "/drive.mp4", simulator, garden::OccupancyMap{}));
   LoopOptions loop;
   loop.time_limit = duration;
 
@@ -119,6 +123,7 @@ int RunDrive(const DriveOptions& options) {
     failure = e.what();
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
+  if (video) video->Close();  // also after a failed drive: what happened up to it
   const auto report_start = Clock::now();
   log.Write();
   nlohmann::json summary = Summary(options, plan, config, simulator, log, listener.telemetry());

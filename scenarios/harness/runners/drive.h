@@ -17,6 +17,7 @@ struct DriveOptions {
   int msaa_samples = 4;
   bool cameras = true;
   bool quiet = false;
+  bool video = false;  // drive.mp4 beside the log (reports/trial_video.h)
   ProjectPaths paths;
 };
 
