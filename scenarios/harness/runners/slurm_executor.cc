@@ -224,6 +224,10 @@ std::vector<Task> PlanTasks(const std::vector<BatchOptions>& batches, const std:
                                        "--jobs",
                                        std::to_string(options.cpus_per_task)};
       for (const auto& o : batch.overrides) argv.insert(argv.end(), {"--set", o});
+      // What each trial records, as asked of the batch.
+      if (batch.video) argv.emplace_back("--video");
+      if (!batch.bag) argv.emplace_back("--no-bag");
+      if (batch.keep_worlds) argv.emplace_back("--keep-worlds");
       task.command = CommandLine(argv);
       tasks.push_back(task);
     }
