@@ -6,6 +6,7 @@
 //   pilot: sensor messages (and fixes) in -> commands out -> simulator
 //   observers: see the step (sensors, ground truth, commands, the stack's telemetry)
 // Ground truth goes to the fixture and the observers, never to the pilot.
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -49,6 +50,11 @@ class Observer {
   virtual ~Observer() = default;
   virtual void Observe(const StepView& step) = 0;
 };
+
+// For an observer sampling at `rate` Hz: the next sample time after a sample at `t`, on the grid
+// k / rate (where the trial's TUM files sample too), robust to the steps' rounding. Sample when
+// step.time + 1e-9 >= it.
+inline double NextSampleTime(double t, double rate) { return (std::floor(t * rate + 1e-6) + 1.0) / rate; }
 
 struct LoopOptions {
   double time_limit = 0.0;  // s of simulated time

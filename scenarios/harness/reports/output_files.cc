@@ -11,6 +11,11 @@
 
 namespace trimbot::scenarios {
 
+cv::Mat ImageView(const messages::Image& image) {
+  return cv::Mat(image.height, image.width, image.encoding == "mono8" ? CV_8UC1 : CV_8UC3,
+                 const_cast<std::uint8_t*>(image.data.data()));
+}
+
 void WritePng(const std::string& path, const cv::Mat& image, bool rgb_order) {
   cv::Mat out = image;
   if (rgb_order && image.channels() == 3) cv::cvtColor(image, out, cv::COLOR_RGB2BGR);

@@ -3,7 +3,13 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "trimbot/messages/sensor_messages.h"
+
 namespace trimbot::scenarios {
+
+// A camera image as a cv::Mat over its bytes (no copy: valid while `image` is), RGB or mono as
+// its encoding says.
+cv::Mat ImageView(const messages::Image& image);
 
 // cv::Mat in RGB (or single channel) order -> PNG.
 void WritePng(const std::string& path, const cv::Mat& image, bool rgb_order = true);

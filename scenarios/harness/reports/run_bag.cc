@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "reports/output_files.h"
 #include "trimbot/common/input_error.h"
 
 namespace trimbot::scenarios {
@@ -123,11 +124,10 @@ void RunBag::Record(const StepView& step) {
     twist.angular.z = step.commands.base->angular;
     bag_->write("/cmd_vel", Stamp(t), twist);
     ++messages_;
-    next_command_ = (std::floor(t * options_.pose_rate + 1e-6) + 1.0) / options_.pose_rate;
+    next_command_ = NextSampleTime(t, options_.pose_rate);
   }
   if (t + 1e-9 < next_pose_) return;
-  // On the rate's grid (k / pose_rate), where the trial's TUM files sample the ground truth too.
-  next_pose_ = (std::floor(t * options_.pose_rate + 1e-6) + 1.0) / options_.pose_rate;
+  next_pose_ = NextSampleTime(t, options_.pose_rate);
   geometry_msgs::PoseStamped truth;
   truth.header.stamp = Stamp(t);
   truth.header.frame_id = "map";
@@ -191,9 +191,8 @@ void RunBag::RecordSensors(const StepView& step) {
   if (options_.images && step.sensors.ring) {
     for (const auto& image : step.sensors.ring->images) {
       if (image.camera_index != 0 || image.encoding != "rgb8") continue;
-      const cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.data.data()));
       cv::Mat bgr, small;
-      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+      cv::cvtColor(ImageView(image), bgr, cv::COLOR_RGB2BGR);
       const int scale = std::max(1, options_.image_downscale);
       cv::resize(bgr, small, cv::Size(image.width / scale, image.height / scale), 0, 0, cv::INTER_AREA);
       sensor_msgs::CompressedImage message;
@@ -257,7 +256,7 @@ void RunBag::RecordStatic(double t) {
 
 // The navigator's costmap as an occupancy grid (row 0 at the bottom, REP-103's y up).
 void RunBag::RecordCostmap(double t) {
-  next_costmap_ = (std::floor(t * options_.costmap_rate + 1e-6) + 1.0) / options_.costmap_rate;
+  next_costmap_ = NextSampleTime(t, options_.costmap_rate);
   const cv::Mat layers = options_.costmap();
   if (layers.empty()) return;
   nav_msgs::OccupancyGrid grid;

@@ -14,8 +14,7 @@ void SaveRing(const messages::RingFrame& frame, const sim::RingTruth& truth, con
   for (size_t i = 0; i < frame.images.size(); ++i) {
     const auto& image = frame.images[i];
     const std::string cam = dir + "/cam" + std::to_string(i);
-    const cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.data.data()));
-    WritePng(cam + ".png", rgb);
+    WritePng(cam + ".png", ImageView(image));
     if (i < truth.views.size()) {
       const auto& view = truth.views[i];
       WriteDepthPng(cam + "_depth.png", view.depth);

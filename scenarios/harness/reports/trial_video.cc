@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "reports/drawing.h"
+#include "reports/output_files.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/sim/simulator.h"
 
@@ -51,12 +52,11 @@ void TrialVideo::Observe(const StepView& step) {
   if (step.sensors.ring) {
     for (const auto& image : step.sensors.ring->images) {
       if (image.camera_index != 0 || image.encoding != "rgb8") continue;
-      const cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.data.data()));
-      cv::cvtColor(rgb, last_camera_, cv::COLOR_RGB2BGR);
+      cv::cvtColor(ImageView(image), last_camera_, cv::COLOR_RGB2BGR);
     }
   }
   if (step.time + 1e-9 < next_frame_) return;
-  next_frame_ = (std::floor(step.time * options_.rate + 1e-6) + 1.0) / options_.rate;
+  next_frame_ = NextSampleTime(step.time, options_.rate);
 
   const int height = options_.height, external_width = height * 4 / 3;
   cv::Mat frame(height, external_width + kSideWidth, CV_8UC3, cv::Scalar(255, 255, 255));

@@ -1,11 +1,11 @@
 #include "runners/compare.h"
-#include "reports/html_report.h"
 
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 
 #include "evaluation/comparison.h"
+#include "reports/html_report.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 
