@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "test_support.h"
@@ -166,8 +167,9 @@ TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
     EXPECT_GT(blade.linear().col(2).dot(adapted.blades[i].linear().col(2)), std::cos(0.01));
   }
   for (std::size_t i = 0; i < adapted.planned.size(); ++i) {
-    if (!adapted.planned[i])
+    if (!adapted.planned[i]) {
       EXPECT_TRUE(f.FreeMove(adapted.configurations[i], adapted.configurations[i + 1])) << "move " << i;
+    }
   }
 }
 
@@ -378,98 +380,177 @@ TEST(TrimExecutive, FailsWithTheReasonOnAnEmptyScanOrABushOutOfReach) {
     EXPECT_FALSE(trim.report().cut);
     const std::string why = empty ? "no target shape from the scan" : "no cutting path";
     EXPECT_NE(trim.report().failure.find(why), std::string::npos) << trim.report().failure;
-    if (!empty) EXPECT_EQ(trim.report().path_source, "solved in full: no stored paths given");
+    if (!empty) {
+      EXPECT_EQ(trim.report().path_source, "solved in full: no stored paths given");
+    }
   }
 }
 
-// Whether an arm link other than the blade (the URDF's collision cylinders of links 1-6, the
-// cutter's housing included) comes within `margin` of the leaves, the base at the origin.
-bool LinksInLeaves(const robot::RobotDescription& robot, const garden::Foliage& foliage, const Eigen::VectorXd& q,
-                   double margin = 0.0) {
+// The arm link other than the blade (the URDF's collision cylinders of links 1-6, the cutter's
+// housing included) that comes within `margin` of the leaves, the base at `T_map_base`; empty when none.
+std::string LinkInLeaves(const robot::RobotDescription& robot, const garden::Foliage& foliage,
+                         const Eigen::Isometry3d& T_map_base, const Eigen::VectorXd& q, double margin = 0.0) {
   std::map<std::string, double> joints;
   const std::vector<std::string> names = robot.ArmJointNames();
   for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = q(static_cast<int>(i));
   for (const std::string& joint : names) {
     const auto link = robot.urdf().getLink(robot.urdf().getJoint(joint)->child_link_name);
     const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get());
-    const Eigen::Isometry3d T = robot.FramePose(link->name, joints) * robot::ToIsometry(link->collision->origin);
+    const Eigen::Isometry3d T =
+        T_map_base * robot.FramePose(link->name, joints) * robot::ToIsometry(link->collision->origin);
     const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
-    if (foliage.ReachesCylinder(T * -half, T * half, cylinder->radius + margin)) return true;
+    if (foliage.ReachesCylinder(T * -half, T * half, cylinder->radius + margin)) return link->name;
   }
-  return false;
+  return {};
 }
 
-// The arm comes in to the cut and leaves it round the leaves the scan saw, then along the blade's
-// axis: the trajectory run with the blade cutting the bush's true leaves as it sweeps (as the
-// simulator does), no link but the blade reaches into them on the way in or out, nor within 2 cm
-// of them while the blade is clear of them (stereo's noise at the standoff, the leaves' sway).
-TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
-  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+// What the arm touched running a trim's trajectory, the blade cutting the bush's true leaves as it
+// sweeps (as the simulator does), sampled every 0.02 s (the blade moves 1 cm at most, swept in
+// between).
+struct TrimReplay {
+  std::map<std::string, int> touches;              // link touch events, by stage
+  std::map<std::string, int> touches_by;           // the same by "<link> while <stage>"
+  std::map<std::string, int> near;                 // samples within 2 cm of the leaves, the blade clear of them
+  double within_before = 0.0, within_after = 0.0;  // share of the surface within 2 cm of the target
+  double overcut = 0.0;                            // share of the target's volume cut away
+};
+
+TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive& trim,
+                      const Eigen::Isometry3d& T_map_base, garden::Foliage* foliage) {
   const arm::ArmKinematics kinematics(robot);
-  const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
-  const garden::GardenObject bush = TopiaryBall({0.95, 0.0});
-  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.35);  // a bush due for trimming
-  Rng rng = MakeRng(5, "leaves");
-  const std::vector<Eigen::Vector3d> seen =
-      LeavesSeenFrom(foliage, Eigen::Isometry3d::Identity(), -Eigen::Vector3d::UnitX(), rng);
-  TrimParameters parameters;  // a coarse path, for the test's time
-  parameters.poses.spacing = 0.15;
-  parameters.path.rolls = 2;
-  parameters.path.search.restarts = 1;
-  parameters.path.search.warm_restarts = 0;
-  TrimExecutive trim(robot, parameters);
-  messages::ArmJointState joints;
-  joints.position = robot_parameters.arm_home_position;
-  trim.SetJointState(joints);
-  perception::TopiaryShape expected;
-  expected.centre = foliage.pose().translation();
-  expected.half = Eigen::Vector3d::Constant(0.3);
-  trim.Start(0.0, expected, perception::AxesTied::kAll, 1, Eigen::Isometry3d::Identity());
-  trim.SetPerceivedPoints(seen, {});
-  trim.Update(0.1);
-  ASSERT_EQ(trim.mode(), TrimExecutive::Mode::kFitted) << trim.report().failure;
-  trim.StandsAt(Eigen::Isometry3d::Identity());
-  trim.Update(0.2);
-  ASSERT_EQ(trim.mode(), TrimExecutive::Mode::kCutting) << trim.report().failure;
-  EXPECT_EQ(trim.report().moves_round_the_leaves, 2);
-  EXPECT_GT(trim.report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.35";
-  ASSERT_LT(trim.cut_begins(), trim.cut_ends());
   const arm::JointTrajectory& trajectory = trim.trajectory();
   const auto sample = [&](double t) {
     Eigen::VectorXd q, velocity;
     trajectory.Sample(t, &q, &velocity);
-    const Eigen::Isometry3d blade = kinematics.EndEffectorPose(q) * robot.BladeInCutter();
+    const Eigen::Isometry3d blade = T_map_base * kinematics.EndEffectorPose(q) * robot.BladeInCutter();
     garden::BladeDisc disc;
     disc.centre = blade.translation();
     disc.axis = blade.linear().col(2);
     disc.radius = 0.05;
     return std::make_pair(q, disc);
   };
-  std::map<std::string, int> touches, near;  // link touch events, and samples within 2 cm, by stage
+  TrimReplay replay;
+  replay.within_before = foliage->Measure().surface_within_tolerance;
   bool touching = false;
   garden::BladeDisc last = sample(0.0).second;
-  for (double t = 0.02; t <= trajectory.duration(); t += 0.02) {  // the blade 1 cm at most (swept in between)
+  for (double t = 0.02; t <= trajectory.duration(); t += 0.02) {
     const auto [q, disc] = sample(t);
-    foliage.Cut(last, disc);
+    foliage->Cut(last, disc);
     last = disc;
-    const bool in = LinksInLeaves(robot, foliage, q);
+    const std::string link = LinkInLeaves(robot, *foliage, T_map_base, q);
     const std::string stage = t < trim.cut_begins() ? "moving in" : t > trim.cut_ends() ? "moving out" : "cutting";
-    if (in && !touching) ++touches[stage];
-    touching = in;
+    if (!link.empty() && !touching) {
+      ++replay.touches[stage];
+      ++replay.touches_by[link + " while " + stage];
+    }
+    touching = !link.empty();
     const Eigen::Vector3d thickness = 0.002 * disc.axis;
-    if (stage != "cutting" && !foliage.ReachesCylinder(disc.centre - thickness, disc.centre + thickness, disc.radius)) {
-      near[stage] += LinksInLeaves(robot, foliage, q, 0.02) ? 1 : 0;
+    if (stage != "cutting" &&
+        !foliage->ReachesCylinder(disc.centre - thickness, disc.centre + thickness, disc.radius)) {
+      replay.near[stage] += LinkInLeaves(robot, *foliage, T_map_base, q, 0.02).empty() ? 0 : 1;
     }
   }
-  EXPECT_EQ(touches["moving in"], 0);
-  EXPECT_EQ(touches["moving out"], 0);
-  EXPECT_EQ(near["moving in"], 0);
-  EXPECT_EQ(near["moving out"], 0);
+  const garden::CutQuality after = foliage->Measure();
+  replay.within_after = after.surface_within_tolerance;
+  replay.overcut = after.overcut_volume / after.target_volume;
+  return replay;
+}
+
+// The trim of `foliage` from a base at T_map_base: the leaves facing `towards` seen (as stereo
+// would), the target fitted to them, the path planned and its trajectory made. Coarse (for the
+// test's time): 0.15 m between blade poses, 2 rolls, one restart of the search.
+std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, const garden::Foliage& foliage,
+                                        const perception::TopiaryShape& expected, perception::AxesTied tied,
+                                        const Eigen::Isometry3d& T_map_base, const Eigen::Vector3d& towards) {
+  const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
+  Rng rng = MakeRng(5, "leaves");
+  TrimParameters parameters;
+  parameters.poses.spacing = 0.15;
+  parameters.path.rolls = 2;
+  parameters.path.search.restarts = 1;
+  parameters.path.search.warm_restarts = 0;
+  auto trim = std::make_unique<TrimExecutive>(robot, parameters);
+  messages::ArmJointState joints;
+  joints.position = robot_parameters.arm_home_position;
+  trim->SetJointState(joints);
+  trim->Start(0.0, expected, tied, 1, Eigen::Isometry3d::Identity());
+  trim->SetPerceivedPoints(LeavesSeenFrom(foliage, T_map_base, towards, rng), {});
+  trim->Update(0.1);
+  if (trim->mode() != TrimExecutive::Mode::kFitted) return trim;
+  trim->StandsAt(Eigen::Isometry3d::Identity());
+  trim->Update(0.2);
+  return trim;
+}
+
+// The arm comes in to the cut and leaves it round the leaves the scan saw, then along the blade's
+// axis: the trajectory run with the blade cutting the bush's true leaves, no link but the blade
+// reaches into them on the way in or out, nor within 2 cm of them while the blade is clear of them
+// (stereo's noise at the standoff, the leaves' sway).
+TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  const garden::GardenObject bush = TopiaryBall({0.95, 0.0});
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.35);  // a bush due for trimming
+  perception::TopiaryShape expected;
+  expected.centre = foliage.pose().translation();
+  expected.half = Eigen::Vector3d::Constant(0.3);
+  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kAll, Eigen::Isometry3d::Identity(),
+                             -Eigen::Vector3d::UnitX());
+  ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
+  EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
+  EXPECT_GT(trim->report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.35";
+  ASSERT_LT(trim->cut_begins(), trim->cut_ends());
+  TrimReplay replay = ReplayTrim(robot, *trim, Eigen::Isometry3d::Identity(), &foliage);
+  EXPECT_EQ(replay.touches["moving in"], 0);
+  EXPECT_EQ(replay.touches["moving out"], 0);
+  EXPECT_EQ(replay.near["moving in"], 0);
+  EXPECT_EQ(replay.near["moving out"], 0);
   std::printf(
       "round the leaves seen %.1f cm deep: link touches moving in %d, cutting %d, moving out %d; within 2 cm of "
       "the leaves, the blade clear: moving in %d, moving out %d samples\n",
-      100.0 * trim.report().leaf_depth, touches["moving in"], touches["cutting"], touches["moving out"],
-      near["moving in"], near["moving out"]);
+      100.0 * trim->report().leaf_depth, replay.touches["moving in"], replay.touches["cutting"],
+      replay.touches["moving out"], replay.near["moving in"], replay.near["moving out"]);
+}
+
+// A box due for trimming (generated_7's, growth 0.35) cut from its corner, where the navigator
+// stands for a box: moving in and out touches nothing, the share within 2 cm rises, the over-cut
+// stays under issue 31's 1 %. The cutter's housing (link 6, 3 cm round, 1-14 cm behind the 5 cm
+// blade) does reach into the leaves while cutting the faces near the corner, reported here and not
+// yet asserted (issue 31's 0 is missed): the foliage's columns run radially from the box's centre,
+// 30-40 deg off a face's normal there, so leaves rooted beside the blade's swath lean over the
+// housing, which trails the blade along the normal (docs/design.md, Trimming).
+TEST(TrimExecutive, TrimsABoxFromItsCorner) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  garden::GardenObject box;
+  box.id = 4;
+  box.object_class = garden::ObjectClass::kTopiary;
+  box.shape = garden::Shape::kBox;
+  box.size = {0.86, 0.84, 0.75};
+  // The arm's axis (0.23 m ahead of base_link) trim.surface_gap (0.45 m) from the surveyed outline
+  // (half the larger side), a corner towards the base.
+  box.position = {0.23 + 0.43 + 0.45, 0.0};
+  box.yaw = M_PI / 4.0;
+  garden::Foliage foliage = garden::Foliage::Grown(box, 4, 0.35);
+  perception::TopiaryShape expected;
+  expected.horizontal_exponent = 6.0;
+  expected.vertical_exponent = 6.0;
+  expected.centre = foliage.pose().translation();
+  expected.half = box.size / 2.0;
+  expected.yaw = box.yaw;
+  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kNone, Eigen::Isometry3d::Identity(),
+                             -Eigen::Vector3d::UnitX());
+  ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
+  EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
+  TrimReplay replay = ReplayTrim(robot, *trim, Eigen::Isometry3d::Identity(), &foliage);
+  std::printf(
+      "box from its corner: %d of %d blade poses reached; within 2 cm %.1f %% -> %.1f %%, over-cut %.2f %%; link "
+      "touches moving in %d, cutting %d, moving out %d\n",
+      trim->report().reached, trim->report().poses, 100.0 * replay.within_before, 100.0 * replay.within_after,
+      100.0 * replay.overcut, replay.touches["moving in"], replay.touches["cutting"], replay.touches["moving out"]);
+  for (const auto& [what, count] : replay.touches_by) std::printf("  %s: %d\n", what.c_str(), count);
+  EXPECT_EQ(replay.touches["moving in"], 0);
+  EXPECT_EQ(replay.touches["moving out"], 0);
+  EXPECT_GT(replay.within_after, replay.within_before + 0.02) << "one corner of four: a few points";
+  EXPECT_LT(replay.overcut, 0.01);
 }
 
 }  // namespace

@@ -135,6 +135,17 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimOutcome, goal, bush, success, cut, failur
                                    fit_centre_offset_m, fit_half_m, leaf_depth_m, moves_round_the_leaves, arm_contacts,
                                    foliage_touches, foliage_touches_by)
 
+// A trim's wall-clock time beside its simulated time (issue 31: trimming one bush must not take
+// longer in wall time than in simulated time). Wall clock: timing.json only, never summary.json.
+struct TrimTiming {
+  int goal = 0;
+  int bush = 0;
+  double simulated_seconds = 0.0;  // from the approach's end to the arm back at rest (TrimOutcome::trim_seconds)
+  double wall_seconds = 0.0;       // the same span, wall clock: the stack's planning, the ring's rendering, ...
+  double planning_seconds = 0.0;   // of it, the stack's fit and path (wall clock)
+};
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimTiming, goal, bush, simulated_seconds, wall_seconds, planning_seconds)
+
 struct TrialResult {
   int index = 0;
   std::uint64_t seed = 0;
@@ -165,12 +176,12 @@ struct TrialResult {
   int localization_stopped_updates = 0;
   std::vector<std::string> faults;  // what was injected, in words
   std::vector<EstimateErrors> estimates;
-  std::vector<BushFrame> bush_frames;         // bush goals' sightings
-  std::vector<ArmGoalOutcome> arm_goals;      // arm_reach trials
-  int arm_contacts = 0;                       // arm contact events (MuJoCo), all goals
-  std::vector<double> arm_planning_seconds;   // wall clock per plan: timing.json only, not reproducible
-  std::vector<TrimOutcome> trims;             // trim goals
-  std::vector<double> trim_planning_seconds;  // wall clock per trim (fit and path): timing.json only
+  std::vector<BushFrame> bush_frames;        // bush goals' sightings
+  std::vector<ArmGoalOutcome> arm_goals;     // arm_reach trials
+  int arm_contacts = 0;                      // arm contact events (MuJoCo), all goals
+  std::vector<double> arm_planning_seconds;  // wall clock per plan: timing.json only, not reproducible
+  std::vector<TrimOutcome> trims;            // trim goals
+  std::vector<TrimTiming> trim_timings;      // wall clock per trim: timing.json only, not reproducible
 };
 
 // One pass criterion of the scenario, e.g. success_rate >= 1.0.

@@ -78,7 +78,10 @@ void TrimEvaluator::Observe(const StepView& step) {
   const auto trim =
       std::find_if(trims_.begin(), trims_.end(), [&](const Trim& t) { return t.goal == telemetry->trim->goal; });
   if (trim == trims_.end()) return;
-  if (trim->started < 0.0) trim->started = step.time;
+  if (trim->started < 0.0) {
+    trim->started = step.time;
+    trim->wall_started = std::chrono::steady_clock::now();
+  }
   // The fit is in base_link as it stood for the scan.
   if (telemetry->trim->mode == trimming::ToString(trimming::TrimExecutive::Mode::kWaitingForPoints)) {
     trim->T_map_base = step.truth.T_map_base;
@@ -114,6 +117,9 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.leaf_depth_m = report.leaf_depth;
   o.moves_round_the_leaves = report.moves_round_the_leaves;
   trim->planning_seconds = report.planning_seconds;
+  if (trim->started >= 0.0) {
+    trim->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trim->wall_started).count();
+  }
   if (!report.fit) return;
   // The fit in base_link, placed where the base truly stood, against the true target.
   const garden::Foliage& foliage = *simulator_.foliage(o.bush);
@@ -139,7 +145,9 @@ void TrimEvaluator::Finish(TrialResult* result) const {
     o.success = o.cut && o.arm_contacts == 0 && o.foliage_touches == 0;
     all = all && o.success;
     result->trims.push_back(o);
-    if (trim.planning_seconds >= 0.0) result->trim_planning_seconds.push_back(trim.planning_seconds);
+    if (trim.wall_seconds >= 0.0) {
+      result->trim_timings.push_back({o.goal, o.bush, o.trim_seconds, trim.wall_seconds, trim.planning_seconds});
+    }
   }
   if (!all && result->success) {
     result->success = false;

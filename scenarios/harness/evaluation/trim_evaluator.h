@@ -6,6 +6,7 @@
 // the blade reaching into the foliage (its collision cylinders against the foliage as cut so far) -
 // and sets the stack's fitted target (base_link, placed by the true base pose) against the true one.
 #include <Eigen/Geometry>
+#include <chrono>
 #include <optional>
 #include <string>
 #include <utility>
@@ -28,7 +29,7 @@ class TrimEvaluator : public Observer {
   // The simulator must have been made with TrimBushes(scenario) cuttable; it outlives the evaluator.
   TrimEvaluator(const sim::Simulator& simulator, const Scenario& scenario);
   void Observe(const StepView& step) override;
-  // The trims' outcomes (result->trims, trim_planning_seconds); a trim that failed fails the trial.
+  // The trims' outcomes (result->trims, trim_timings); a trim that failed fails the trial.
   void Finish(TrialResult* result) const;
   // Per trim bush: foliage_<id>_before.ply and _after.ply (the leaf surface with its signed
   // distance to the target).
@@ -48,6 +49,8 @@ class TrimEvaluator : public Observer {
     garden::Foliage before;
     TrimOutcome outcome;
     double started = -1.0;                                         // s: the stack's trim began (-1: not yet)
+    std::chrono::steady_clock::time_point wall_started;            // the same, wall clock
+    double wall_seconds = -1.0;                                    // wall clock from start to the stack's result
     Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // true, when it began
     double planning_seconds = -1.0;
     bool touching = false;

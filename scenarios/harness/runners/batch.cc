@@ -157,6 +157,7 @@ struct BatchTiming {
   std::optional<RunTiming> summed;  // stages summed over the trials that wrote them
   json arm_planning;                // {plans, median, p90, max} in ms; null without arm plans
   json navigation_planning;         // the same for the navigator's global plans
+  json trims;                       // every trim's TrimTiming and real-time factor; null without trims
 };
 
 // Plans' wall-clock times (s) as milliseconds: count, median, 90th percentile, max.
@@ -172,6 +173,7 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   std::vector<visual_localization::LocalizationTimings> frames;  // of every trial's visual localization
   std::vector<RunTiming> runs;
   std::vector<double> arm_plans, navigation_plans;  // s, every plan of every trial
+  json trims = json::array();                       // every trial's trims' timings
   for (const auto& r : results) {
     trials.push_back({{"index", r.index}, {"seed", r.seed}, {"wall_seconds", r.wall_seconds}});
     total += r.wall_seconds;
@@ -188,6 +190,14 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
       const auto plans = timing["arm_planning_seconds"].get<std::vector<double>>();
       arm_plans.insert(arm_plans.end(), plans.begin(), plans.end());
     }
+    if (timing.is_object() && timing.contains("trims")) {
+      for (json trim : timing["trims"]) {
+        const double wall = trim.value("wall_seconds", 0.0);
+        trim["trial"] = r.index;
+        trim["real_time_factor"] = wall > 0.0 ? trim.value("simulated_seconds", 0.0) / wall : 0.0;
+        trims.push_back(trim);
+      }
+    }
     if (timing.is_object() && timing.contains("navigation_planning_seconds")) {
       const auto plans = timing["navigation_planning_seconds"].get<std::vector<double>>();
       navigation_plans.insert(navigation_plans.end(), plans.begin(), plans.end());
@@ -200,6 +210,7 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   json report{{"trials", trials}, {"mean_wall_seconds", results.empty() ? 0.0 : total / results.size()}};
   if (!arm_plans.empty()) report["arm_planning_ms"] = PlanTimeStats(arm_plans);
   if (!navigation_plans.empty()) report["navigation_planning_ms"] = PlanTimeStats(navigation_plans);
+  if (!trims.empty()) report["trims"] = trims;
   if (!frames.empty()) {
     report["visual_localization"] = LocalizationTimeStats(frames);
     report["visual_localization"].erase("frames_ms");  // in the trials' files
@@ -210,6 +221,7 @@ BatchTiming WriteTiming(const std::string& out, const std::vector<TrialResult>& 
   BatchTiming timing;
   if (report.contains("arm_planning_ms")) timing.arm_planning = report["arm_planning_ms"];
   if (report.contains("navigation_planning_ms")) timing.navigation_planning = report["navigation_planning_ms"];
+  if (report.contains("trims")) timing.trims = report["trims"];
   if (!runs.empty()) {
     timing.summed = Sum(runs);
     report["stages_summed_over_trials"] = ToJson(*timing.summed);
@@ -225,6 +237,18 @@ void LogPlanTimes(std::ostream& log, const std::string& what, const json& plans)
   if (plans.is_null()) return;
   log << what << ": median " << plans["median"].get<double>() << " ms, 90th percentile " << plans["p90"].get<double>()
       << " ms, max " << plans["max"].get<double>() << " ms over " << plans["plans"].get<int>() << " plans\n";
+}
+
+// One line per trim: its real-time factor (simulated / wall seconds) and what planning took of it.
+void LogTrimTimes(std::ostream& log, const json& trims) {
+  if (trims.is_null()) return;
+  log << "trims (wall clock; real-time factor = simulated / wall seconds):\n";
+  for (const json& t : trims) {
+    log << "  trial " << t["trial"].get<int>() << " goal " << t["goal"].get<int>() << " bush " << t["bush"].get<int>()
+        << ": " << t["simulated_seconds"].get<double>() << " s simulated in " << t["wall_seconds"].get<double>()
+        << " s (real-time factor " << t["real_time_factor"].get<double>() << "), of which planning "
+        << t["planning_seconds"].get<double>() << " s\n";
+  }
 }
 
 // report.html of the batch in `out`. The batch's results stand without the page: a page that
@@ -309,6 +333,7 @@ int WriteReports(const std::string& out, const std::string& final_out, const Sce
   if (timing.summed) log << "summed over the trials' processes, " << FormatRunTiming(*timing.summed);
   LogPlanTimes(log, "navigation planning (wall clock, goal candidates included)", timing.navigation_planning);
   LogPlanTimes(log, "arm planning (wall clock, IK included)", timing.arm_planning);
+  LogTrimTimes(log, timing.trims);
   log << "outputs in " << final_out << " (report.html, summary.json, junit.xml, timing.json, timing.png, "
       << (scenario.arm_reach
               ? "arm_reach.png; per trial arm_goals.csv, arm_pose_NN.png)\n"

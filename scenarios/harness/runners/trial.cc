@@ -117,7 +117,7 @@ void WriteTiming(const std::string& dir, const RunTiming& run, const stack::Stac
   nlohmann::json timing = ToJson(run);
   if (bag_seconds >= 0.0) timing["run_bag_seconds"] = bag_seconds;
   if (!result.arm_planning_seconds.empty()) timing["arm_planning_seconds"] = result.arm_planning_seconds;
-  if (!result.trim_planning_seconds.empty()) timing["trim_planning_seconds"] = result.trim_planning_seconds;
+  if (!result.trim_timings.empty()) timing["trims"] = result.trim_timings;
   if (!t.plans.empty()) timing["navigation_planning_seconds"] = t.plans;
   WriteRunTimingChart(dir + "/timing.png", "where the trial's time went", run);
   if (!t.visual_frames.empty()) {
