@@ -204,6 +204,25 @@ TEST(CuttingPathDatabase, RoundTripsFindsTheNearestAndRefusesWhatItCannotUse) {
   ASSERT_NE(nearest, nullptr);
   EXPECT_EQ(nearest->motion_time, 0.35);
   EXPECT_NEAR(distance, std::sqrt(3.0) * 0.01, 1e-9);
+  // A ball's yaw is the base's heading, not its shape's: it does not count; a square box's counts
+  // modulo a quarter turn, an oblong one's modulo a half turn.
+  query.yaw = 1.3;
+  loaded.Nearest(query, &distance);
+  EXPECT_NEAR(distance, std::sqrt(3.0) * 0.01, 1e-9) << "a round plan turned";
+  CuttingPathDatabase boxes;
+  StoredCuttingPath box = *nearest;
+  box.target.horizontal_exponent = box.target.vertical_exponent = 6.0;
+  boxes.Add(box);
+  perception::TopiaryShape turned = box.target;
+  for (const double turn : {M_PI / 2.0, -M_PI, 0.1 + M_PI / 2.0}) {
+    turned.yaw = box.target.yaw + turn;
+    boxes.Nearest(turned, &distance);
+    EXPECT_NEAR(distance, turned.half.mean() * std::abs(std::remainder(turn, M_PI / 2.0)), 1e-9) << turn;
+  }
+  turned.half.x() += 0.1;  // oblong: a quarter turn is another shape
+  turned.yaw = box.target.yaw + M_PI / 2.0;
+  boxes.Nearest(turned, &distance);
+  EXPECT_NEAR(distance, 0.1 + turned.half.mean() * M_PI / 2.0, 1e-9);
   query.vertical_exponent = 6.0;
   EXPECT_EQ(loaded.Nearest(query), nullptr) << "no cylinder stored";
 

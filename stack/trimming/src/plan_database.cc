@@ -6,7 +6,6 @@
 #include <sstream>
 
 #include "trimbot/common/input_error.h"
-#include "trimbot/common/pose2.h"
 #include "trimbot/common/sqlite_file.h"
 
 namespace trimbot::trimming {
@@ -97,6 +96,16 @@ std::vector<StoredCuttingPath> ReadPaths(sqlite3* db) {
   return paths;
 }
 
+// The turn about z from a stored target to `target` as far as `target`'s shape can tell: turns
+// that map the shape onto itself are taken off - any turn of a round plan (equal horizontal
+// semi-axes, round sides), quarter turns of a square one, half turns of any other. (A round bush's
+// yaw is what the base's heading makes it; it says nothing about the shape.)
+double ShapeTurn(const perception::TopiaryShape& target, double stored_yaw) {
+  const bool square = std::abs(target.half.x() - target.half.y()) < 1e-9;
+  if (square && std::abs(target.horizontal_exponent - 2.0) < 1e-9) return 0.0;
+  return std::remainder(target.yaw - stored_yaw, square ? M_PI / 2.0 : M_PI);
+}
+
 }  // namespace
 
 std::string ArmSignature(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade) {
@@ -149,7 +158,7 @@ const StoredCuttingPath* CuttingPathDatabase::Nearest(const perception::TopiaryS
         std::abs(p.target.vertical_exponent - target.vertical_exponent) > 1e-9)
       continue;
     const double d = (p.target.centre - target.centre).norm() + (p.target.half - target.half).norm() +
-                     target.half.mean() * std::abs(WrapAngle(p.target.yaw - target.yaw));
+                     target.half.mean() * std::abs(ShapeTurn(target, p.target.yaw));
     if (d < best) {
       best = d;
       nearest = &p;
@@ -177,9 +186,10 @@ CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::
                              const CuttingPathOptions& options) {
   CuttingPath path;
   path.configurations.push_back(start);
-  // From the stored target's frame to the new one's: its centre and yaw.
+  // From the stored target's frame to the new one's: its centre and yaw (the least turn that
+  // gives the same shape: a round bush's poses stay on the side the base faces).
   const Eigen::Matrix3d turn =
-      Eigen::AngleAxisd(WrapAngle(target.yaw - stored.target.yaw), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(ShapeTurn(target, stored.target.yaw), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
   for (std::size_t k = 0; k < stored.blades.size(); ++k) {
     const Eigen::Vector3d direction = turn * (stored.blades[k].translation() - stored.target.centre).normalized();

@@ -42,8 +42,9 @@ class CuttingPathDatabase {
   static CuttingPathDatabase Load(const std::string& path, const std::string& expected_arm_signature);
 
   // The stored path whose target is nearest `target` among those of the same exponents (distance:
-  // centres' plus semi-axes' differences plus the yaw's at the mean semi-axis, m); nullptr when
-  // the database holds none of that shape.
+  // centres' plus semi-axes' differences plus the yaw's at the mean semi-axis, m, the yaw's modulo
+  // the turns that leave `target`'s shape as it is: any for a round plan); nullptr when the database
+  // holds none of that shape.
   const StoredCuttingPath* Nearest(const perception::TopiaryShape& target, double* distance = nullptr) const;
 
  private:
