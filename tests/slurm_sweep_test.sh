@@ -6,7 +6,9 @@
 #      that does not exist, a work folder that cannot be written, a controller that does not answer;
 #   2. a 3-point sweep of the smoke scenario submitted as one job array, one array task cancelled
 #      while it runs: it is reported with its seed and resubmitted, and every point's merged
-#      summary.json (and sweep.json) is byte-identical to the same sweep run here.
+#      summary.json (and sweep.json) is byte-identical to the same sweep run here;
+#   3. a `run --slurm --no-bag --video` batch: its array task runs with what the batch asked - its
+#      trial has trial.mp4 and no run.bag.
 # Exit 77 (ctest: skipped) where Slurm is not installed or cannot start (not root, no daemons).
 # Usage: slurm_sweep_test.sh TRIMBOT SOURCE_DIR OUT_DIR [TRIALS]
 set -uo pipefail
@@ -87,3 +89,11 @@ for point in "$out"/local/points/*; do
 done
 cmp "$out/local/sweep.json" "$out/slurm/sweep.json" || fail "sweep.json differs from the local run's"
 echo "3 points x $trials trials: every merged summary.json is byte-identical to the local sweep's"
+
+# 3. What a batch asks each trial to record reaches the array tasks.
+"$trimbot" run "$scenario" --trials 1 --out "$out/recorded" --slurm --poll-seconds 1 --no-bag --video \
+  > "$out/recorded.log" 2>&1 || fail "trimbot run --slurm --no-bag --video failed: $(tail -n 5 "$out/recorded.log")"
+grep -q -- "--no-bag" "$out"/recorded.slurm/submission_*/tasks.txt || fail "the array task was not given --no-bag"
+[ -s "$out/recorded/trials/000/trial.mp4" ] || fail "the Slurm task's trial wrote no trial.mp4 (--video)"
+[ ! -e "$out/recorded/trials/000/run.bag" ] || fail "the Slurm task's trial wrote run.bag (--no-bag)"
+echo "run --slurm --no-bag --video: the task's trial has trial.mp4 and no run.bag"

@@ -1,6 +1,7 @@
 #include "reports/html_report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -92,6 +93,18 @@ json ReadJson(const std::string& path) {
   }
 }
 
+// `render` of the JSON in `path`; a field it needs that is missing or of another type is an
+// InputError naming the file: "<path>: is not <what>: <the field>".
+template <typename Render>
+std::string RenderJsonFile(const std::string& path, const std::string& what, Render render) {
+  const json content = ReadJson(path);
+  try {
+    return render(content);
+  } catch (const json::exception& e) {
+    throw InputError(path, "is not " + what + ": " + e.what());
+  }
+}
+
 // The PNG files directly in `dir`, by name (relative to the page: `prefix` + name).
 std::vector<std::string> Pictures(const std::string& dir, const std::string& prefix) {
   std::vector<std::string> names;
@@ -117,11 +130,26 @@ std::vector<std::string> Without(std::vector<std::string> pictures, const std::s
   return pictures;
 }
 
+// A relative path as a link's URL: every byte but RFC 3986's unreserved characters and '/'
+// percent-encoded (a file named "a #1.png" would otherwise link to "a ").
+std::string UrlPath(const std::string& path) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string url;
+  for (const unsigned char c : path) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
+      url += static_cast<char>(c);
+    } else {
+      url += {'%', kHex[c >> 4], kHex[c & 15]};
+    }
+  }
+  return url;
+}
+
 std::string Figures(const std::vector<std::string>& pictures) {
   std::string html;
   for (const auto& src : pictures) {
-    const std::string name = fs::path(src).filename().string();
-    html += "<figure><a href=\"" + XmlEscape(src) + "\"><img src=\"" + XmlEscape(src) + "\" alt=\"" + XmlEscape(name) +
+    const std::string name = fs::path(src).filename().string(), url = UrlPath(src);
+    html += "<figure><a href=\"" + url + "\"><img src=\"" + url + "\" alt=\"" + XmlEscape(name) +
             "\"></a><figcaption>" + XmlEscape(name) + "</figcaption></figure>\n";
   }
   return html;
@@ -270,7 +298,7 @@ std::string TrialSection(const std::string& dir, const json& trial) {
     std::sort(files.begin(), files.end());
     html += "<p class=\"meta\">files:";
     for (const auto& f : files)
-      html += " <a href=\"trials/" + name + "/" + XmlEscape(f) + "\">" + XmlEscape(f) + "</a>";
+      html += " <a href=\"" + UrlPath("trials/" + name + "/" + f) + "\">" + XmlEscape(f) + "</a>";
     html += "</p>\n";
   }
   return html + "</section>\n";
@@ -299,12 +327,7 @@ std::string TimingTables(const std::string& dir, const json& timing) {
 std::string TimingSection(const std::string& dir) {
   const std::string path = dir + "/timing.json";
   if (!fs::exists(path)) return "";
-  const json timing = ReadJson(path);
-  try {
-    return TimingTables(dir, timing);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("is not a batch's timing: ") + e.what());
-  }
+  return RenderJsonFile(path, "a batch's timing", [&](const json& timing) { return TimingTables(dir, timing); });
 }
 
 // The criteria of a batch summary (summary.json), pass/fail coloured.
@@ -328,9 +351,7 @@ std::string CriteriaSection(const json& summary) {
 }
 
 std::string BatchPage(const std::string& dir) {
-  const std::string path = dir + "/summary.json";
-  const json summary = ReadJson(path);
-  try {
+  return RenderJsonFile(dir + "/summary.json", "a batch summary", [&](const json& summary) {
     const std::string scenario = summary.at("scenario").get<std::string>();
     const bool pass = summary.at("pass").get<bool>();
     const json& trials = summary.at("trials");
@@ -385,15 +406,11 @@ std::string BatchPage(const std::string& dir) {
         "<a href=\"#criteria\">criteria</a><a href=\"#metrics\">metrics</a><a href=\"#plots\">plots</a>"
         "<a href=\"#trials\">trials</a><a href=\"#timing\">timing</a>";
     return Page(scenario + ": batch report", nav, body);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("is not a batch summary: ") + e.what());
-  }
+  });
 }
 
 std::string SweepPage(const std::string& dir) {
-  const std::string path = dir + "/sweep.json";
-  const json sweep = ReadJson(path);
-  try {
+  return RenderJsonFile(dir + "/sweep.json", "a sweep result", [&](const json& sweep) {
     const std::string scenario = sweep.at("scenario").get<std::string>();
     std::string body = "<h1>" + XmlEscape(scenario) + ": sweep</h1>\n<p class=\"meta\">scenario file " +
                        Cell(sweep.value("scenario_file", json(""))) + "; grids " + Cell(sweep.at("grids")) + "</p>\n";
@@ -430,15 +447,11 @@ std::string SweepPage(const std::string& dir) {
     body += "</table></div>\n<h2 id=\"plots\">Plots</h2>\n" + Figures(Pictures(dir, "")) +
             Figures(Pictures(dir + "/plots", "plots/"));
     return Page(scenario + ": sweep", "<a href=\"#points\">points</a><a href=\"#plots\">plots</a>", body);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("is not a sweep result: ") + e.what());
-  }
+  });
 }
 
 std::string ComparisonPage(const std::string& dir) {
-  const std::string path = dir + "/comparison.json";
-  const json comparison = ReadJson(path);
-  try {
+  return RenderJsonFile(dir + "/comparison.json", "a comparison", [&](const json& comparison) {
     const bool regressed = comparison.at("verdict").get<std::string>() == "regressed";
     std::string body =
         "<h1>" + Cell(comparison.at("scenario")) + ": comparison " + Verdict(!regressed, "no regression", "REGRESSED") +
@@ -462,26 +475,19 @@ std::string ComparisonPage(const std::string& dir) {
       body += "<h2 id=\"power\">Trials needed to see a change</h2>\n" + ObjectsTable(comparison["power"]);
     body += Figures(Pictures(dir, ""));
     return Page(comparison["scenario"].get<std::string>() + ": comparison", "", body);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("is not a comparison: ") + e.what());
-  }
+  });
 }
 
 // A suite: its criteria (summary.json: the suite as one batch), the gardens' table (suite.json)
 // with each garden's own batch report, and the rest of suite.json as it stands.
 std::string SuitePage(const std::string& dir) {
-  const std::string path = dir + "/suite.json";
-  const json suite = ReadJson(path);
-  try {
+  return RenderJsonFile(dir + "/suite.json", "a suite result", [&](const json& suite) {
     const std::string name = suite.at("suite").get<std::string>();
     std::string body = "<h1>" + XmlEscape(name) + ": suite";
     if (fs::exists(dir + "/summary.json")) {
-      const json summary = ReadJson(dir + "/summary.json");
-      try {
-        body += " " + Verdict(summary.at("pass").get<bool>()) + "</h1>\n" + CriteriaSection(summary);
-      } catch (const json::exception& e) {
-        throw InputError(dir + "/summary.json", std::string("is not a batch summary: ") + e.what());
-      }
+      body += RenderJsonFile(dir + "/summary.json", "a batch summary", [](const json& summary) {
+        return " " + Verdict(summary.at("pass").get<bool>()) + "</h1>\n" + CriteriaSection(summary);
+      });
     } else {
       body += "</h1>\n";
     }
@@ -505,9 +511,7 @@ std::string SuitePage(const std::string& dir) {
           "<p>navigation_planning_ms</p>" +
           KeyValueTable(planning);
     return Page(name + ": suite", "", body);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("is not a suite result: ") + e.what());
-  }
+  });
 }
 
 // tune.json: its tables as they stand, and the folder's plots.

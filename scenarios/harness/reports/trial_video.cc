@@ -96,16 +96,17 @@ cv::Mat TrialVideo::TopView(const StepView& step) const {
                        height / 2.0 - (p.y - centre.y()) / metres_per_px);
   };
   if (!map_.occupied.empty()) {
-    for (int row = 0; row < height; ++row) {
-      for (int col = 0; col < kSideWidth; ++col) {
-        const Eigen::Vector2d p(centre.x() + (col - kSideWidth / 2.0) * metres_per_px,
-                                centre.y() - (row - height / 2.0) * metres_per_px);
-        const cv::Point cell = map_.Cell(p);
-        if (cell.x >= 0 && cell.y >= 0 && cell.x < map_.occupied.cols && cell.y < map_.occupied.rows &&
-            map_.occupied.at<std::uint8_t>(cell) > 0)
-          view.at<cv::Vec3b>(row, col) = cv::Vec3b(120, 120, 120);
-      }
-    }
+    // The map's cells under the view's pixels in one resampling: pixel (col, row) is the map point
+    // centre + ((col - w/2) m, -(row - h/2) m), whose cell OccupancyMap::Cell gives (nearest
+    // neighbour rounds where Cell floors: the half cell taken off).
+    const double scale = metres_per_px / map_.resolution;
+    const cv::Matx23d view_to_cell(
+        scale, 0.0, (centre.x() - map_.origin.x()) / map_.resolution - kSideWidth / 2.0 * scale - 0.5,  //
+        0.0, scale, map_.occupied.rows - 0.5 - (centre.y() - map_.origin.y()) / map_.resolution - height / 2.0 * scale);
+    cv::Mat occupied;
+    cv::warpAffine(map_.occupied, occupied, view_to_cell, view.size(), cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+                   cv::BORDER_CONSTANT, 0);
+    view.setTo(cv::Scalar(120, 120, 120), occupied > 0);
   }
   const auto polyline = [&](const std::vector<cv::Point2d>& path, const cv::Scalar& colour, int thickness) {
     for (std::size_t i = 1; i < path.size(); ++i)
