@@ -412,13 +412,9 @@ std::string LinkInLeaves(const robot::RobotDescription& robot, const garden::Fol
   std::map<std::string, double> joints;
   const std::vector<std::string> names = robot.ArmJointNames();
   for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = q(static_cast<int>(i));
-  for (const std::string& joint : names) {
-    const auto link = robot.urdf().getLink(robot.urdf().getJoint(joint)->child_link_name);
-    const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get());
-    const Eigen::Isometry3d T =
-        T_map_base * robot.FramePose(link->name, joints) * robot::ToIsometry(link->collision->origin);
-    const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
-    if (foliage.ReachesCylinder(T * -half, T * half, cylinder->radius + margin)) return link->name;
+  for (const robot::LinkCylinder& cylinder : robot.ArmLinkCylinders()) {
+    const Eigen::Isometry3d T = T_map_base * robot.FramePose(cylinder.link, joints);
+    if (foliage.ReachesCylinder(T * cylinder.a, T * cylinder.b, cylinder.radius + margin)) return cylinder.link;
   }
   return {};
 }
@@ -508,7 +504,7 @@ std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, co
 TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
   const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
   const garden::GardenObject bush = TopiaryBall({0.95, 0.0});
-  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.35);  // a bush due for trimming
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.33);  // a bush due for trimming (scenarios/trim)
   perception::TopiaryShape expected;
   expected.centre = foliage.pose().translation();
   expected.half = Eigen::Vector3d::Constant(0.3);
@@ -516,7 +512,7 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
                              -Eigen::Vector3d::UnitX());
   ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
   EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
-  EXPECT_GT(trim->report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.35";
+  EXPECT_GT(trim->report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.33";
   ASSERT_LT(trim->cut_begins(), trim->cut_ends());
   TrimReplay replay = ReplayTrim(robot, *trim, Eigen::Isometry3d::Identity(), &foliage);
   EXPECT_EQ(replay.touches["moving in"], 0);
@@ -530,13 +526,14 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
       replay.touches["moving out"], replay.near["moving in"], replay.near["moving out"]);
 }
 
-// A box due for trimming (generated_7's, growth 0.35) cut from its corner, where the navigator
+// A box due for trimming (generated_7's, growth 0.33) cut from its corner, where the navigator
 // stands for a box: moving in and out touches nothing, the share within 2 cm rises, the over-cut
 // stays under issue 31's 1 %. The cutter's housing (link 6, 3 cm round, 1-14 cm behind the 5 cm
-// blade) does reach into the leaves while cutting the faces near the corner, reported here and not
-// yet asserted (issue 31's 0 is missed): the foliage's columns run radially from the box's centre,
-// 30-40 deg off a face's normal there, so leaves rooted beside the blade's swath lean over the
-// housing, which trails the blade along the normal (docs/design.md, Trimming).
+// blade) can reach into the leaves while cutting the faces near the corner (11 times with the
+// stack's own pose spacing and rolls, docs/design.md): reported here, not asserted (issue 31's 0
+// is missed there). The foliage's columns run radially from the box's centre, 30-40 deg off a
+// face's normal near the corner, so leaves rooted beside the blade's swath lean over the housing,
+// which trails the blade along the normal.
 TEST(TrimExecutive, TrimsABoxFromItsCorner) {
   const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
   garden::GardenObject box;
@@ -548,7 +545,7 @@ TEST(TrimExecutive, TrimsABoxFromItsCorner) {
   // (half the larger side), a corner towards the base.
   box.position = {0.23 + 0.43 + 0.45, 0.0};
   box.yaw = M_PI / 4.0;
-  garden::Foliage foliage = garden::Foliage::Grown(box, 4, 0.35);
+  garden::Foliage foliage = garden::Foliage::Grown(box, 4, 0.33);
   perception::TopiaryShape expected;
   expected.horizontal_exponent = 6.0;
   expected.vertical_exponent = 6.0;

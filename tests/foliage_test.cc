@@ -127,6 +127,55 @@ TEST(Foliage, GrowthLowersTheShareOfTheSurfaceNearTheTarget) {
   }
 }
 
+// The share leaves out the surface the bush stands on (no leaf grows out of a box's underside: it
+// would count as within 2 cm however the bush was cut), and is also given over the upper half,
+// which the arm reaches: a ball's upper half cut to its target by blades plunged in all over it
+// is within 2 cm there, the whole bush well short of that.
+TEST(Foliage, TheShareLeavesOutTheGroundAndIsGivenOverTheUpperHalf) {
+  const Foliage box = Foliage::Grown(Topiary(Shape::kBox, {0.8, 0.8, 0.7}), 2, 0.5);
+  int on_the_ground = 0;
+  for (int i = 0; i < box.columns(); ++i) {
+    const double z = box.direction(i).z();
+    if (z < -0.95) {
+      EXPECT_TRUE(box.OnTheGround(i, 0.02)) << "column " << i << " ends at the underside";
+    }
+    if (box.OnTheGround(i, 0.02)) {
+      EXPECT_LT(z, -0.4) << "column " << i;
+      ++on_the_ground;
+    }
+  }
+  EXPECT_GT(on_the_ground, 100);
+  Foliage ball = Foliage::Grown(Topiary(Shape::kEllipsoid, {0.7, 0.7, 0.7}), 2, 0.5);
+  for (int i = 0; i < ball.columns(); ++i) {
+    if (ball.OnTheGround(i, 0.02)) {
+      EXPECT_LT(ball.direction(i).z(), -std::cos(0.35)) << "a ball rests on a point";
+    }
+  }
+  const CutQuality grown = ball.Measure();
+  // Discs plunged along the target's inward normal from 15 cm out to 5 mm inside it, every ~4 cm
+  // over the upper half (a Fibonacci hemisphere).
+  const Superellipsoid& target = ball.target();
+  for (int k = 0; k < 400; ++k) {
+    const double z = 1.0 - (k + 0.5) / 400.0, r = std::sqrt(1.0 - z * z), a = 2.39996 * k;
+    const Eigen::Vector3d d(r * std::cos(a), r * std::sin(a), z);
+    const Eigen::Vector3d surface = target.Radius(d) * d, normal = target.Normal(surface);
+    BladeDisc from, to;
+    from.centre = ball.pose() * (surface + 0.15 * normal);
+    to.centre = ball.pose() * (surface - 0.005 * normal);
+    from.axis = to.axis = ball.pose().linear() * normal;
+    from.radius = to.radius = 0.05;
+    ball.Cut(from, to);
+  }
+  const CutQuality cut = ball.Measure();
+  std::printf(
+      "grown ball: %.1f %% within 2 cm (upper half %.1f %%); its upper half cut: %.1f %% (upper half %.1f %%)\n",
+      100.0 * grown.surface_within_tolerance, 100.0 * grown.upper_surface_within_tolerance,
+      100.0 * cut.surface_within_tolerance, 100.0 * cut.upper_surface_within_tolerance);
+  EXPECT_LT(grown.upper_surface_within_tolerance, 0.5);
+  EXPECT_GT(cut.upper_surface_within_tolerance, 0.9);
+  EXPECT_LT(cut.surface_within_tolerance, cut.upper_surface_within_tolerance - 0.3);
+}
+
 TEST(Foliage, AHousingBehindABladeThatCutItsWayInIsClearOfTheLeavesBesideItIsNot) {
   const GardenObject bush = Topiary(Shape::kEllipsoid, {0.7, 0.7, 0.7});
   Foliage foliage = Foliage::Grown(bush, 4, 0.5);

@@ -253,7 +253,7 @@ double Foliage::SurfaceDistance(int i) const {
 
 CutQuality Foliage::Measure(double tolerance) const {
   CutQuality q;
-  double area = 0.0, within = 0.0;
+  double area = 0.0, within = 0.0, upper_area = 0.0, upper_within = 0.0;
   for (std::size_t i = 0; i < radius_.size(); ++i) {
     const double r = radius_[i], t = target_radius_[i], w = solid_angle_[i];
     q.overgrowth_volume += w * (std::pow(std::max(r, t), 3) - std::pow(t, 3)) / 3.0;
@@ -262,11 +262,18 @@ CutQuality Foliage::Measure(double tolerance) const {
     q.max_overgrowth = std::max(q.max_overgrowth, r - t);
     // The distance along the target's normal, and the surface element the column's solid angle
     // spans at its radius.
+    if (OnTheGround(static_cast<int>(i), tolerance)) continue;
     const double element = w * r * r / NormalCosine(i);
+    const double near = std::abs(SurfaceDistance(static_cast<int>(i))) <= tolerance ? element : 0.0;
     area += element;
-    if (std::abs(SurfaceDistance(static_cast<int>(i))) <= tolerance) within += element;
+    within += near;
+    if (direction_[i].z() >= 0.0) {
+      upper_area += element;
+      upper_within += near;
+    }
   }
   q.surface_within_tolerance = area > 0.0 ? within / area : 0.0;
+  q.upper_surface_within_tolerance = upper_area > 0.0 ? upper_within / upper_area : 0.0;
   return q;
 }
 

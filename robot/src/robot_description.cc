@@ -136,6 +136,20 @@ Eigen::Isometry3d RobotDescription::BladeInCutter() const {
          FramePose(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
 }
 
+std::vector<LinkCylinder> RobotDescription::ArmLinkCylinders() const {
+  std::vector<LinkCylinder> cylinders;
+  for (const std::string& joint : ArmJointNames()) {
+    const auto link = model_->getLink(model_->getJoint(joint)->child_link_name);
+    if (!link || !link->collision || !link->collision->geometry) continue;
+    const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get());
+    if (cylinder == nullptr) continue;
+    const Eigen::Isometry3d T_link_cylinder = ToIsometry(link->collision->origin);
+    const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
+    cylinders.push_back({link->name, T_link_cylinder * -half, T_link_cylinder * half, cylinder->radius});
+  }
+  return cylinders;
+}
+
 double RobotDescription::BladeRadius() const {
   const auto link = model_->getLink(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
   const auto* cylinder = link && link->collision && link->collision->geometry

@@ -274,7 +274,7 @@ void AddArmMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metri
 
 // Metrics of trim goals (see ComputeBatchMetrics).
 void AddTrimMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metrics) {
-  std::vector<double> before, after, overcut, fit, cutting;
+  std::vector<double> before, after, upper_before, upper_after, overcut, fit, cutting;
   int trims = 0, succeeded = 0, contacts = 0, touches = 0;
   for (const TrialResult& trial : trials) {
     for (const TrimOutcome& trim : trial.trims) {
@@ -284,6 +284,8 @@ void AddTrimMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metr
       touches += trim.foliage_touches;
       before.push_back(trim.within_2cm_before);
       after.push_back(trim.within_2cm_after);
+      upper_before.push_back(trim.within_2cm_upper_before);
+      upper_after.push_back(trim.within_2cm_upper_after);
       overcut.push_back(trim.overcut_share);
       if (trim.fit_centre_error_m >= 0.0) fit.push_back(trim.fit_centre_error_m);
       if (trim.cut) cutting.push_back(trim.cutting_seconds);
@@ -297,6 +299,8 @@ void AddTrimMetrics(const std::vector<TrialResult>& trials, nlohmann::json& metr
   metrics["trim_within_2cm_before_mean"] = ErrorStats::From(before).mean;
   metrics["trim_within_2cm_after_mean"] = ErrorStats::From(after).mean;
   metrics["trim_within_2cm_after_min"] = *std::min_element(after.begin(), after.end());
+  metrics["trim_within_2cm_upper_before_mean"] = ErrorStats::From(upper_before).mean;
+  metrics["trim_within_2cm_upper_after_mean"] = ErrorStats::From(upper_after).mean;
   metrics["trim_overcut_mean"] = ErrorStats::From(overcut).mean;
   metrics["trim_overcut_max"] = ErrorStats::From(overcut).max;
   if (!fit.empty()) metrics["trim_fit_centre_error_max_m"] = ErrorStats::From(fit).max;

@@ -107,6 +107,8 @@ struct TrimOutcome {
   std::string failure;             // the stack's reason when it did not
   double within_2cm_before = 0.0;  // share of the foliage surface within 2 cm of the target
   double within_2cm_after = 0.0;
+  double within_2cm_upper_before = 0.0;  // the same above the target's centre (the half the arm reaches)
+  double within_2cm_upper_after = 0.0;
   double overcut_share = 0.0;         // of the target's volume cut away
   double overgrowth_before_m3 = 0.0;  // foliage volume outside the target
   double overgrowth_after_m3 = 0.0;
@@ -129,11 +131,12 @@ struct TrimOutcome {
   std::map<std::string, int> foliage_touches_by;  // the same by "<link> while <the trim's stage>"
 };
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after,
-                                   overcut_share, overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
-                                   trim_seconds, points, poses, reached_poses, from_database, path_source,
-                                   motion_seconds, nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m,
-                                   fit_centre_offset_m, fit_half_m, leaf_depth_m, moves_round_the_leaves, arm_contacts,
-                                   foliage_touches, foliage_touches_by)
+                                   within_2cm_upper_before, within_2cm_upper_after, overcut_share, overgrowth_before_m3,
+                                   overgrowth_after_m3, cutting_seconds, trim_seconds, points, poses, reached_poses,
+                                   from_database, path_source, motion_seconds, nearest_neighbour_seconds,
+                                   fit_centre_error_m, fit_axes_error_max_m, fit_centre_offset_m, fit_half_m,
+                                   leaf_depth_m, moves_round_the_leaves, arm_contacts, foliage_touches,
+                                   foliage_touches_by)
 
 // A trim's wall-clock time beside its simulated time (issue 31: trimming one bush must not take
 // longer in wall time than in simulated time). Wall clock: timing.json only, never summary.json.
@@ -235,7 +238,8 @@ void to_json(nlohmann::json& j, const BatchSummary& b);
 // arm_orientation_error_{mean,max}_deg (goals the stack reported reached), arm_tracking_error_max_rad,
 // arm_min_clearance_m, arm_path_length_mean_rad, arm_cutter_path_length_mean_m; with trim goals:
 // trim_goals, trim_success_rate, trim_arm_contacts, trim_foliage_touches,
-// trim_within_2cm_{before_mean,after_mean,after_min}, trim_overcut_{mean,max},
+// trim_within_2cm_{before_mean,after_mean,after_min}, trim_within_2cm_upper_{before_mean,after_mean},
+// trim_overcut_{mean,max},
 // trim_fit_centre_error_max_m, trim_cutting_seconds_mean.
 nlohmann::json ComputeBatchMetrics(const std::vector<TrialResult>& trials, int trials_planned);
 

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <map>
 
-#include "trimbot/robot/robot_description.h"
-
 namespace trimbot::scenarios {
 namespace {
 
@@ -24,18 +22,8 @@ std::vector<int> TrimBushes(const Scenario& scenario) {
   return bushes;
 }
 
-TrimEvaluator::TrimEvaluator(const sim::Simulator& simulator, const Scenario& scenario) : simulator_(simulator) {
-  const robot::RobotDescription& robot = simulator.robot();
-  for (const std::string& joint : robot.ArmJointNames()) {
-    const std::string link = robot.urdf().getJoint(joint)->child_link_name;
-    const auto model = robot.urdf().getLink(link);
-    if (!model || !model->collision || !model->collision->geometry) continue;
-    const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(model->collision->geometry.get());
-    if (cylinder == nullptr) continue;
-    const Eigen::Isometry3d T_link_cylinder = robot::ToIsometry(model->collision->origin);
-    const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
-    links_.push_back({link, T_link_cylinder * -half, T_link_cylinder * half, cylinder->radius});
-  }
+TrimEvaluator::TrimEvaluator(const sim::Simulator& simulator, const Scenario& scenario)
+    : simulator_(simulator), links_(simulator.robot().ArmLinkCylinders()) {
   for (std::size_t g = 0; g < scenario.goals.size(); ++g) {
     const ScenarioGoal& goal = scenario.goals[g];
     if (!goal.cut) continue;
@@ -46,6 +34,7 @@ TrimEvaluator::TrimEvaluator(const sim::Simulator& simulator, const Scenario& sc
     trim.outcome.bush = goal.bush;
     const garden::CutQuality quality = trim.before.Measure(kTolerance);
     trim.outcome.within_2cm_before = quality.surface_within_tolerance;
+    trim.outcome.within_2cm_upper_before = quality.upper_surface_within_tolerance;
     trim.outcome.overgrowth_before_m3 = quality.overgrowth_volume;
     trim.outcome.failure = "not reached: the bush was not approached";
     trims_.push_back(std::move(trim));
@@ -57,7 +46,7 @@ std::string TrimEvaluator::LinkInFoliage(const sim::GroundTruth& truth, const ga
   std::map<std::string, double> joints;
   const std::vector<std::string> names = robot.ArmJointNames();
   for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = truth.arm_position[i];
-  for (const LinkCylinder& cylinder : links_) {
+  for (const robot::LinkCylinder& cylinder : links_) {
     const Eigen::Isometry3d T_map_link = truth.T_map_base * robot.FramePose(cylinder.link, joints);
     if (foliage.ReachesCylinder(T_map_link * cylinder.a, T_map_link * cylinder.b, cylinder.radius)) {
       return cylinder.link;
@@ -140,6 +129,7 @@ void TrimEvaluator::Finish(TrialResult* result) const {
     TrimOutcome o = trim.outcome;
     const garden::CutQuality after = simulator_.foliage(o.bush)->Measure(kTolerance);
     o.within_2cm_after = after.surface_within_tolerance;
+    o.within_2cm_upper_after = after.upper_surface_within_tolerance;
     o.overgrowth_after_m3 = after.overgrowth_volume;
     o.overcut_share = after.target_volume > 0.0 ? after.overcut_volume / after.target_volume : 0.0;
     o.success = o.cut && o.arm_contacts == 0 && o.foliage_touches == 0;

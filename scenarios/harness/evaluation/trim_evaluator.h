@@ -17,6 +17,7 @@
 #include "loop/closed_loop.h"
 #include "loop/scenario.h"
 #include "trimbot/garden/foliage.h"
+#include "trimbot/robot/robot_description.h"
 #include "trimbot/sim/simulator.h"
 
 namespace trimbot::scenarios {
@@ -38,12 +39,6 @@ class TrimEvaluator : public Observer {
   const garden::Foliage& before(int bush) const;
 
  private:
-  // An arm link's collision cylinder: its link, axis end points and radius in the link's frame.
-  struct LinkCylinder {
-    std::string link;
-    Eigen::Vector3d a, b;
-    double radius = 0.0;
-  };
   struct Trim {
     int goal = 0;
     garden::Foliage before;
@@ -61,7 +56,7 @@ class TrimEvaluator : public Observer {
   void Record(const stack::TrimResult& result, double now);
 
   const sim::Simulator& simulator_;
-  std::vector<LinkCylinder> links_;
+  std::vector<robot::LinkCylinder> links_;  // the arm's links but the blade
   std::vector<Trim> trims_;
   ContactEvents contact_events_;  // MuJoCo's arm contacts
   long steps_ = 0;

@@ -282,7 +282,8 @@ bool IsKnownMetric(const std::string& name) {
                   "arm_orientation_error_max_deg", "arm_path_length_mean_rad", "arm_cutter_path_length_mean_m"});
     names.insert({"trim_goals", "trim_success_rate", "trim_arm_contacts", "trim_foliage_touches",
                   "trim_within_2cm_before_mean", "trim_within_2cm_after_mean", "trim_within_2cm_after_min",
-                  "trim_overcut_mean", "trim_overcut_max", "trim_fit_centre_error_max_m", "trim_cutting_seconds_mean"});
+                  "trim_within_2cm_upper_before_mean", "trim_within_2cm_upper_after_mean", "trim_overcut_mean",
+                  "trim_overcut_max", "trim_fit_centre_error_max_m", "trim_cutting_seconds_mean"});
     for (const char* bush : {"bush_distance_error", "bush_bearing_error", "bush_estimate_distance_error",
                              "bush_estimate_bearing_error", "bush_frame_distance_error", "bush_frame_bearing_error"}) {
       names.insert(std::string(bush) + "_mean");

@@ -10,7 +10,7 @@ namespace {
 
 constexpr double kTolerance = 0.02;  // m: the cut criterion's (van Marrewijk et al. 2022)
 constexpr int kScale = 4;            // pixels per column
-const cv::Scalar kCutIn(30, 90, 200), kWithin(60, 170, 70);
+const cv::Scalar kCutIn(30, 90, 200), kWithin(60, 170, 70), kOnTheGround(190, 190, 190);
 
 cv::Scalar DistanceColour(double d) {
   if (d < -kTolerance) return kCutIn;
@@ -25,7 +25,8 @@ cv::Mat DistanceMap(const garden::Foliage& foliage, const std::string& title) {
   for (int i = 0; i < foliage.columns(); ++i) {
     const int row = i / foliage.segments(), column = i % foliage.segments();
     cv::rectangle(image, cv::Rect(column * kScale, top + row * kScale, kScale, kScale),
-                  DistanceColour(foliage.SurfaceDistance(i)), cv::FILLED);
+                  foliage.OnTheGround(i, kTolerance) ? kOnTheGround : DistanceColour(foliage.SurfaceDistance(i)),
+                  cv::FILLED);
   }
   PutText(image, title, {6, 20}, 0.5, kInk);
   return image;
@@ -36,18 +37,22 @@ std::string Percent(double share) { return FormatFixed(100.0 * share, 1) + " %";
 }  // namespace
 
 void WriteTrimDistanceMap(const std::string& path, const garden::Foliage& before, const garden::Foliage& after) {
-  const double within_before = before.Measure(kTolerance).surface_within_tolerance;
-  const double within_after = after.Measure(kTolerance).surface_within_tolerance;
+  const auto title = [](const std::string& when, const garden::Foliage& foliage) {
+    const garden::CutQuality q = foliage.Measure(kTolerance);
+    return when + ": " + Percent(q.surface_within_tolerance) + " within 2 cm (upper half " +
+           Percent(q.upper_surface_within_tolerance) + ")";
+  };
   cv::Mat image;
-  cv::hconcat(DistanceMap(before, "before: " + Percent(within_before) + " within 2 cm"),
-              cv::Mat(before.rings() * kScale + 30, 12, CV_8UC3, kWhite), image);
-  cv::hconcat(image, DistanceMap(after, "after: " + Percent(within_after) + " within 2 cm"), image);
+  cv::hconcat(DistanceMap(before, title("before", before)), cv::Mat(before.rings() * kScale + 30, 12, CV_8UC3, kWhite),
+              image);
+  cv::hconcat(image, DistanceMap(after, title("after", after)), image);
   cv::Mat legend(40, image.cols, CV_8UC3, kWhite);
   Legend(legend, 20,
          {{"cut > 2 cm into the target", kCutIn},
           {"within 2 cm", kWithin},
           {"2-10 cm over", DistanceColour(0.05)},
-          {"> 10 cm over", DistanceColour(1.0)}});
+          {"> 10 cm over", DistanceColour(1.0)},
+          {"on the ground (not counted)", kOnTheGround}});
   cv::vconcat(image, legend, image);
   WritePng(path, image, true);
 }

@@ -57,11 +57,17 @@ struct BladeDisc {
 };
 
 struct CutQuality {
-  double surface_within_tolerance = 0.0;  // share of the foliage surface within the tolerance of the target
-  double overgrowth_volume = 0.0;         // m^3 of foliage outside the target
-  double overcut_volume = 0.0;            // m^3 of the target without foliage (cut into)
-  double target_volume = 0.0;             // m^3
-  double max_overgrowth = 0.0;            // m: the largest radial excess over the target
+  // Share of the foliage surface within the tolerance of the target. Not counted: where the target
+  // lies within the tolerance of the ground plane the bush stands on (a box's or cylinder's flat
+  // underside): no leaf grows out there, so it would count as within however the bush was cut.
+  double surface_within_tolerance = 0.0;
+  // The same over the surface above the target's centre: the half the arm reaches from a standoff
+  // (docs/design.md, Trimming: no blade pose below a bush's equator has a solution).
+  double upper_surface_within_tolerance = 0.0;
+  double overgrowth_volume = 0.0;  // m^3 of foliage outside the target
+  double overcut_volume = 0.0;     // m^3 of the target without foliage (cut into)
+  double target_volume = 0.0;      // m^3
+  double max_overgrowth = 0.0;     // m: the largest radial excess over the target
 };
 
 class Foliage {
@@ -98,6 +104,12 @@ class Foliage {
 
   // Column i's end from the target, along the target's normal (m; outside > 0).
   double SurfaceDistance(int i) const;
+  // Whether column i's target lies within `tolerance` of the ground plane the shape stands on (no
+  // leaf grows out there: Measure leaves it out).
+  bool OnTheGround(int i, double tolerance) const {
+    const auto k = static_cast<std::size_t>(i);
+    return floor_radius_[k] - target_radius_[k] < tolerance;
+  }
 
   int columns() const { return static_cast<int>(radius_.size()); }
   int rings() const { return rings_; }  // columns are ring-major: i = ring * segments + segment

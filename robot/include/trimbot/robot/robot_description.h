@@ -28,6 +28,13 @@ struct RobotFrames {
   static std::string ArmJoint(int index) { return "arm_joint_" + std::to_string(index + 1); }
 };
 
+// A link's collision cylinder: its axis' end points in the link's frame, and its radius.
+struct LinkCylinder {
+  std::string link;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
 class RobotDescription {
  public:
   // Throws InputError naming the file if it is missing, malformed, or lacks a required frame.
@@ -48,6 +55,9 @@ class RobotDescription {
 
   DiffDriveGeometry drive() const { return drive_; }
   std::vector<std::string> ArmJointNames() const;
+  // The collision cylinders of the links the arm's joints move (links 1-6, the cutter's housing
+  // included; the blade is the cutter joint's, not among them): what must keep out of the leaves.
+  std::vector<LinkCylinder> ArmLinkCylinders() const;
   // The base's outline on the ground: the xy bounding box in base_link (min, max) of the collision
   // geometry of base_link and the wheels (what touches a bush or an obstacle first; the ring and
   // the arm at rest stand within it).
