@@ -93,6 +93,55 @@ TEST(CuttingPath, EachStandoffTakesItsSectorOfTheCrown) {
   EXPECT_EQ(reached, top);
 }
 
+// `path` (planned over f.target) stored and adapted to a bush 3.6 cm off and 2 cm larger: each
+// blade on the new surface, from the stored solution's branch, no move refused.
+void ExpectAdaptedToAMovedBush(Fixture& f, const CuttingPath& path, const CuttingPathOptions& options) {
+  perception::TopiaryShape moved = f.target;
+  moved.centre += Eigen::Vector3d(0.03, -0.02, 0.0);
+  moved.half = Eigen::Vector3d::Constant(0.32);
+  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, moved);
+  const auto adapt_start = std::chrono::steady_clock::now();
+  const CuttingPath adapted = AdaptCuttingPath(
+      f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), moved,
+      [&](const Eigen::VectorXd& q) { return f.Valid(q); },
+      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); }, options);
+  const double adapt_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - adapt_start).count();
+  ASSERT_TRUE(adapted.ok) << adapted.failure;
+  std::printf("adapted to a bush 3.6 cm off, 2 cm larger: %zu of %zu poses, tour %.1f s, in %.0f ms\n",
+              adapted.poses.size(), path.poses.size(), adapted.motion_time, 1000.0 * adapt_seconds);
+  EXPECT_GE(adapted.poses.size() * 2, path.poses.size()) << "most poses carry over (the rest are reported)";
+  for (std::size_t i = 0; i < adapted.blades.size(); ++i) {
+    EXPECT_NEAR(moved.RadialDistance(adapted.blades[i].translation()), 0.0, 1e-6);
+    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(adapted.configurations[i + 1]) * f.T_cutter_blade;
+    EXPECT_LT((blade.translation() - adapted.blades[i].translation()).norm(), 1e-3);
+    EXPECT_GT(blade.linear().col(2).dot(adapted.blades[i].linear().col(2)), std::cos(0.01));
+  }
+  for (std::size_t i = 0; i < adapted.planned.size(); ++i) {
+    if (!adapted.planned[i]) {
+      EXPECT_TRUE(f.FreeMove(adapted.configurations[i], adapted.configurations[i + 1])) << "move " << i;
+    }
+  }
+}
+
+// `path` stored and adapted to the same round bush at another yaw, as a fit with its axes free
+// finds it: a round bush's yaw is what the base's heading made it, the stored blade poses stay.
+void ExpectAdaptedToATurnedRoundBush(Fixture& f, const CuttingPath& path, const CuttingPathOptions& options) {
+  perception::TopiaryShape turned = f.target;
+  turned.yaw = 1.3;
+  turned.half.x() += 0.005;
+  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, turned);
+  const CuttingPath same = AdaptCuttingPath(
+      f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), turned,
+      [&](const Eigen::VectorXd& q) { return f.Valid(q); },
+      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); }, options);
+  ASSERT_TRUE(same.ok) << same.failure;
+  EXPECT_GE(same.poses.size() * 10, path.poses.size() * 9);
+  for (std::size_t i = 0; i < same.blades.size(); ++i) {
+    const auto k = static_cast<std::size_t>(same.poses[i]);
+    EXPECT_LT((same.blades[i].translation() - path.blades[k].translation()).norm(), 0.006) << "pose " << k;
+  }
+}
+
 TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   Fixture f;
   CuttingPoseOptions pose_options;
@@ -144,33 +193,8 @@ TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   EXPECT_GT(straight, static_cast<int>(path.poses.size()) / 2) << "most moves go straight from pose to pose";
   EXPECT_LE(path.motion_time, path.nearest_neighbour_time);
 
-  // The path stored and adapted to a bush 3.6 cm off and 2 cm larger: each blade on the new
-  // surface, from the stored solution's branch, no move refused.
-  perception::TopiaryShape moved = f.target;
-  moved.centre += Eigen::Vector3d(0.03, -0.02, 0.0);
-  moved.half = Eigen::Vector3d::Constant(0.32);
-  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, moved);
-  const auto adapt_start = std::chrono::steady_clock::now();
-  const CuttingPath adapted = AdaptCuttingPath(
-      f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), moved,
-      [&](const Eigen::VectorXd& q) { return f.Valid(q); },
-      [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return f.FreeMove(a, b); }, options);
-  const double adapt_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - adapt_start).count();
-  ASSERT_TRUE(adapted.ok) << adapted.failure;
-  std::printf("adapted to a bush 3.6 cm off, 2 cm larger: %zu of %zu poses, tour %.1f s, in %.0f ms\n",
-              adapted.poses.size(), path.poses.size(), adapted.motion_time, 1000.0 * adapt_seconds);
-  EXPECT_GE(adapted.poses.size() * 2, path.poses.size()) << "most poses carry over (the rest are reported)";
-  for (std::size_t i = 0; i < adapted.blades.size(); ++i) {
-    EXPECT_NEAR(moved.RadialDistance(adapted.blades[i].translation()), 0.0, 1e-6);
-    const Eigen::Isometry3d blade = f.kinematics.EndEffectorPose(adapted.configurations[i + 1]) * f.T_cutter_blade;
-    EXPECT_LT((blade.translation() - adapted.blades[i].translation()).norm(), 1e-3);
-    EXPECT_GT(blade.linear().col(2).dot(adapted.blades[i].linear().col(2)), std::cos(0.01));
-  }
-  for (std::size_t i = 0; i < adapted.planned.size(); ++i) {
-    if (!adapted.planned[i]) {
-      EXPECT_TRUE(f.FreeMove(adapted.configurations[i], adapted.configurations[i + 1])) << "move " << i;
-    }
-  }
+  ExpectAdaptedToAMovedBush(f, path, options);
+  ExpectAdaptedToATurnedRoundBush(f, path, options);
 }
 
 // Stored paths: found by the nearest target of the same shape, written and read back, and refused
@@ -209,6 +233,10 @@ TEST(CuttingPathDatabase, RoundTripsFindsTheNearestAndRefusesWhatItCannotUse) {
   query.yaw = 1.3;
   loaded.Nearest(query, &distance);
   EXPECT_NEAR(distance, std::sqrt(3.0) * 0.01, 1e-9) << "a round plan turned";
+  query.half.x() += 0.005;  // fitted with its axes free: still round within the cut's 2 cm
+  loaded.Nearest(query, &distance);
+  EXPECT_NEAR(distance, Eigen::Vector3d(0.005, 0.01, 0.01).norm(), 1e-9) << "a fitted round plan turned";
+  query.half.x() -= 0.005;
   CuttingPathDatabase boxes;
   StoredCuttingPath box = *nearest;
   box.target.horizontal_exponent = box.target.vertical_exponent = 6.0;
@@ -291,15 +319,21 @@ std::vector<Eigen::Vector3d> LeavesSeenFrom(const garden::Foliage& foliage, cons
 
 // The blade (the URDF's 5 cm disc) swept through the foliage along the path's straight moves,
 // 0.01 rad at a time; the planned moves are taken with the blade clear.
+// The blade's disc (the URDF's 5 cm) with the arm at `q`, the base at T_map_base.
+garden::BladeDisc BladeDiscAt(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                              const Eigen::Isometry3d& T_map_base, const Eigen::VectorXd& q) {
+  const Eigen::Isometry3d blade = T_map_base * kinematics.EndEffectorPose(q) * T_cutter_blade;
+  garden::BladeDisc disc;
+  disc.centre = blade.translation();
+  disc.axis = blade.linear().col(2);
+  disc.radius = 0.05;
+  return disc;
+}
+
 void SweepBlade(const Fixture& f, const CuttingPath& path, const Eigen::Isometry3d& T_map_base,
                 garden::Foliage* foliage) {
   const auto blade_at = [&](const Eigen::VectorXd& q) {
-    const Eigen::Isometry3d blade = T_map_base * f.kinematics.EndEffectorPose(q) * f.T_cutter_blade;
-    garden::BladeDisc disc;
-    disc.centre = blade.translation();
-    disc.axis = blade.linear().col(2);
-    disc.radius = 0.05;
-    return disc;
+    return BladeDiscAt(f.kinematics, f.T_cutter_blade, T_map_base, q);
   };
   for (std::size_t i = 0; i < path.planned.size(); ++i) {
     if (path.planned[i]) continue;
@@ -406,22 +440,23 @@ TEST(TrimExecutive, FailsWithTheReasonOnAnEmptyScanOrABushOutOfReach) {
 }
 
 // The arm link other than the blade (the URDF's collision cylinders of links 1-6, the cutter's
-// housing included) that comes within `margin` of the leaves, the base at `T_map_base`; empty when none.
-std::string LinkInLeaves(const robot::RobotDescription& robot, const garden::Foliage& foliage,
-                         const Eigen::Isometry3d& T_map_base, const Eigen::VectorXd& q, double margin = 0.0) {
+// housing included) that comes within `margin` of the leaves, the base at the map's origin; empty
+// when none.
+std::string LinkInLeaves(const robot::RobotDescription& robot, const garden::Foliage& foliage, const Eigen::VectorXd& q,
+                         double margin = 0.0) {
   std::map<std::string, double> joints;
   const std::vector<std::string> names = robot.ArmJointNames();
   for (std::size_t i = 0; i < names.size(); ++i) joints[names[i]] = q(static_cast<int>(i));
   for (const robot::LinkCylinder& cylinder : robot.ArmLinkCylinders()) {
-    const Eigen::Isometry3d T = T_map_base * robot.FramePose(cylinder.link, joints);
+    const Eigen::Isometry3d T = robot.FramePose(cylinder.link, joints);
     if (foliage.ReachesCylinder(T * cylinder.a, T * cylinder.b, cylinder.radius + margin)) return cylinder.link;
   }
   return {};
 }
 
-// What the arm touched running a trim's trajectory, the blade cutting the bush's true leaves as it
-// sweeps (as the simulator does), sampled every 0.02 s (the blade moves 1 cm at most, swept in
-// between).
+// What the arm touched running a trim's trajectory (the base at the map's origin), the blade cutting
+// the bush's true leaves as it sweeps (as the simulator does), sampled every 0.02 s (the blade moves
+// 1 cm at most, swept in between).
 struct TrimReplay {
   std::map<std::string, int> touches;              // link touch events, by stage
   std::map<std::string, int> touches_by;           // the same by "<link> while <stage>"
@@ -430,19 +465,13 @@ struct TrimReplay {
   double overcut = 0.0;                            // share of the target's volume cut away
 };
 
-TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive& trim,
-                      const Eigen::Isometry3d& T_map_base, garden::Foliage* foliage) {
+TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive& trim, garden::Foliage* foliage) {
   const arm::ArmKinematics kinematics(robot);
   const arm::JointTrajectory& trajectory = trim.trajectory();
   const auto sample = [&](double t) {
     Eigen::VectorXd q, velocity;
     trajectory.Sample(t, &q, &velocity);
-    const Eigen::Isometry3d blade = T_map_base * kinematics.EndEffectorPose(q) * robot.BladeInCutter();
-    garden::BladeDisc disc;
-    disc.centre = blade.translation();
-    disc.axis = blade.linear().col(2);
-    disc.radius = 0.05;
-    return std::make_pair(q, disc);
+    return std::make_pair(q, BladeDiscAt(kinematics, robot.BladeInCutter(), Eigen::Isometry3d::Identity(), q));
   };
   TrimReplay replay;
   replay.within_before = foliage->Measure().surface_within_tolerance;
@@ -452,7 +481,7 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
     const auto [q, disc] = sample(t);
     foliage->Cut(last, disc);
     last = disc;
-    const std::string link = LinkInLeaves(robot, *foliage, T_map_base, q);
+    const std::string link = LinkInLeaves(robot, *foliage, q);
     const std::string stage = t < trim.cut_begins() ? "moving in" : t > trim.cut_ends() ? "moving out" : "cutting";
     if (!link.empty() && !touching) {
       ++replay.touches[stage];
@@ -462,7 +491,7 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
     const Eigen::Vector3d thickness = 0.002 * disc.axis;
     if (stage != "cutting" &&
         !foliage->ReachesCylinder(disc.centre - thickness, disc.centre + thickness, disc.radius)) {
-      replay.near[stage] += LinkInLeaves(robot, *foliage, T_map_base, q, 0.02).empty() ? 0 : 1;
+      replay.near[stage] += LinkInLeaves(robot, *foliage, q, 0.02).empty() ? 0 : 1;
     }
   }
   const garden::CutQuality after = foliage->Measure();
@@ -471,12 +500,12 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
   return replay;
 }
 
-// The trim of `foliage` from a base at T_map_base: the leaves facing `towards` seen (as stereo
+// The trim of `foliage` from a base at the map's origin: the leaves facing `towards` seen (as stereo
 // would), the target fitted to them, the path planned and its trajectory made. Coarse (for the
 // test's time): 0.15 m between blade poses, 2 rolls, one restart of the search.
 std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, const garden::Foliage& foliage,
                                         const perception::TopiaryShape& expected, perception::AxesTied tied,
-                                        const Eigen::Isometry3d& T_map_base, const Eigen::Vector3d& towards) {
+                                        const Eigen::Vector3d& towards) {
   const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
   Rng rng = MakeRng(5, "leaves");
   TrimParameters parameters;
@@ -489,7 +518,7 @@ std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, co
   joints.position = robot_parameters.arm_home_position;
   trim->SetJointState(joints);
   trim->Start(0.0, expected, tied, 1, Eigen::Isometry3d::Identity());
-  trim->SetPerceivedPoints(LeavesSeenFrom(foliage, T_map_base, towards, rng), {});
+  trim->SetPerceivedPoints(LeavesSeenFrom(foliage, Eigen::Isometry3d::Identity(), towards, rng), {});
   trim->Update(0.1);
   if (trim->mode() != TrimExecutive::Mode::kFitted) return trim;
   trim->StandsAt(Eigen::Isometry3d::Identity());
@@ -508,13 +537,12 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
   perception::TopiaryShape expected;
   expected.centre = foliage.pose().translation();
   expected.half = Eigen::Vector3d::Constant(0.3);
-  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kAll, Eigen::Isometry3d::Identity(),
-                             -Eigen::Vector3d::UnitX());
+  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kAll, -Eigen::Vector3d::UnitX());
   ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
   EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
   EXPECT_GT(trim->report().leaf_depth, 0.01) << "shoots out to ~5 cm at growth 0.33";
   ASSERT_LT(trim->cut_begins(), trim->cut_ends());
-  TrimReplay replay = ReplayTrim(robot, *trim, Eigen::Isometry3d::Identity(), &foliage);
+  TrimReplay replay = ReplayTrim(robot, *trim, &foliage);
   EXPECT_EQ(replay.touches["moving in"], 0);
   EXPECT_EQ(replay.touches["moving out"], 0);
   EXPECT_EQ(replay.near["moving in"], 0);
@@ -552,11 +580,10 @@ TEST(TrimExecutive, TrimsABoxFromItsCorner) {
   expected.centre = foliage.pose().translation();
   expected.half = box.size / 2.0;
   expected.yaw = box.yaw;
-  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kNone, Eigen::Isometry3d::Identity(),
-                             -Eigen::Vector3d::UnitX());
+  const auto trim = PlanTrim(robot, foliage, expected, perception::AxesTied::kNone, -Eigen::Vector3d::UnitX());
   ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
   EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
-  TrimReplay replay = ReplayTrim(robot, *trim, Eigen::Isometry3d::Identity(), &foliage);
+  TrimReplay replay = ReplayTrim(robot, *trim, &foliage);
   std::printf(
       "box from its corner: %d of %d blade poses reached; within 2 cm %.1f %% -> %.1f %%, over-cut %.2f %%; link "
       "touches moving in %d, cutting %d, moving out %d\n",

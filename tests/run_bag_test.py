@@ -12,15 +12,9 @@ import sys
 import rosbag
 import yaml
 
+from script_checks import check, finish
+
 trial_dir, robot_parameters = sys.argv[1], sys.argv[2]
-failures = []
-
-
-def check(condition, what):
-    print(("ok   " if condition else "FAIL ") + what)
-    if not condition:
-        failures.append(what)
-
 
 result = json.load(open(trial_dir + "/result.json"))
 parameters = yaml.safe_load(open(robot_parameters))
@@ -146,4 +140,4 @@ check(worst_z < 0.005, f"/ground_truth/pose: z within 5 mm of the ground plane (
 
 image = next(bag.read_messages(topics=["/cam0/image/compressed"]))[1]
 check(image.format == "jpeg" and bytes(image.data[:2]) == b"\xff\xd8", "cam0 images are JPEG")
-sys.exit(1 if failures else 0)
+finish()

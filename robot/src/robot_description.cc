@@ -140,9 +140,14 @@ std::vector<LinkCylinder> RobotDescription::ArmLinkCylinders() const {
   std::vector<LinkCylinder> cylinders;
   for (const std::string& joint : ArmJointNames()) {
     const auto link = model_->getLink(model_->getJoint(joint)->child_link_name);
-    if (!link || !link->collision || !link->collision->geometry) continue;
-    const auto* cylinder = dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get());
-    if (cylinder == nullptr) continue;
+    const auto* cylinder = link && link->collision && link->collision->geometry
+                               ? dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get())
+                               : nullptr;
+    if (cylinder == nullptr) {
+      throw InputError(path_,
+                       "arm link '" + model_->getJoint(joint)->child_link_name +
+                           "' has no collision cylinder (the arm's links are checked against the leaves as such)");
+    }
     const Eigen::Isometry3d T_link_cylinder = ToIsometry(link->collision->origin);
     const Eigen::Vector3d half(0.0, 0.0, cylinder->length / 2.0);
     cylinders.push_back({link->name, T_link_cylinder * -half, T_link_cylinder * half, cylinder->radius});

@@ -97,8 +97,8 @@ cv::Mat TrialVideo::TopView(const StepView& step) const {
   };
   if (!map_.occupied.empty()) {
     // The map's cells under the view's pixels in one resampling: pixel (col, row) is the map point
-    // centre + ((col - w/2) m, -(row - h/2) m), whose cell OccupancyMap::Cell gives (nearest
-    // neighbour rounds where Cell floors: the half cell taken off).
+    // centre + metres_per_px (col - w/2, -(row - h/2)), whose cell OccupancyMap::Cell gives
+    // (nearest neighbour rounds where Cell floors: the half cell taken off).
     const double scale = metres_per_px / map_.resolution;
     const cv::Matx23d view_to_cell(
         scale, 0.0, (centre.x() - map_.origin.x()) / map_.resolution - kSideWidth / 2.0 * scale - 0.5,  //

@@ -96,14 +96,21 @@ std::vector<StoredCuttingPath> ReadPaths(sqlite3* db) {
   return paths;
 }
 
-// The turn about z from a stored target to `target` as far as `target`'s shape can tell: turns
-// that map the shape onto itself are taken off - any turn of a round plan (equal horizontal
-// semi-axes, round sides), quarter turns of a square one, half turns of any other. (A round bush's
-// yaw is what the base's heading makes it; it says nothing about the shape.)
-double ShapeTurn(const perception::TopiaryShape& target, double stored_yaw) {
-  const bool square = std::abs(target.half.x() - target.half.y()) < 1e-9;
-  if (square && std::abs(target.horizontal_exponent - 2.0) < 1e-9) return 0.0;
-  return std::remainder(target.yaw - stored_yaw, square ? M_PI / 2.0 : M_PI);
+// The turn about z from the `stored` target to `target` as far as their shapes can tell: turns that
+// map a shape onto itself are taken off - any turn where either has a round plan, quarter turns
+// where both are square, half turns otherwise. A plan is round or square when its horizontal
+// semi-axes differ by less than the cut's 2 cm (turning it moves its surface less than that): a
+// fitted round bush's are apart by millimetres, and its yaw is what the base's heading made it.
+double ShapeTurn(const perception::TopiaryShape& target, const perception::TopiaryShape& stored) {
+  constexpr double kCutTolerance = 0.02;  // m
+  const auto square = [](const perception::TopiaryShape& s) {
+    return std::abs(s.half.x() - s.half.y()) < kCutTolerance;
+  };
+  const auto round = [&](const perception::TopiaryShape& s) {
+    return square(s) && std::abs(s.horizontal_exponent - 2.0) < 1e-9;
+  };
+  if (round(target) || round(stored)) return 0.0;
+  return std::remainder(target.yaw - stored.yaw, square(target) && square(stored) ? M_PI / 2.0 : M_PI);
 }
 
 }  // namespace
@@ -158,7 +165,7 @@ const StoredCuttingPath* CuttingPathDatabase::Nearest(const perception::TopiaryS
         std::abs(p.target.vertical_exponent - target.vertical_exponent) > 1e-9)
       continue;
     const double d = (p.target.centre - target.centre).norm() + (p.target.half - target.half).norm() +
-                     target.half.mean() * std::abs(ShapeTurn(target, p.target.yaw));
+                     target.half.mean() * std::abs(ShapeTurn(target, p.target));
     if (d < best) {
       best = d;
       nearest = &p;
@@ -189,7 +196,7 @@ CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::
   // From the stored target's frame to the new one's: its centre and yaw (the least turn that
   // gives the same shape: a round bush's poses stay on the side the base faces).
   const Eigen::Matrix3d turn =
-      Eigen::AngleAxisd(ShapeTurn(target, stored.target.yaw), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      Eigen::AngleAxisd(ShapeTurn(target, stored.target), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
   for (std::size_t k = 0; k < stored.blades.size(); ++k) {
     const Eigen::Vector3d direction = turn * (stored.blades[k].translation() - stored.target.centre).normalized();

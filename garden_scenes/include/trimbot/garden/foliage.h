@@ -104,8 +104,8 @@ class Foliage {
 
   // Column i's end from the target, along the target's normal (m; outside > 0).
   double SurfaceDistance(int i) const;
-  // Whether column i's target lies within `tolerance` of the ground plane the shape stands on (no
-  // leaf grows out there: Measure leaves it out).
+  // Whether the ground plane the shape stands on lies within `tolerance` of column i's target,
+  // along the column (no leaf grows out there: Measure leaves it out).
   bool OnTheGround(int i, double tolerance) const {
     const auto k = static_cast<std::size_t>(i);
     return floor_radius_[k] - target_radius_[k] < tolerance;

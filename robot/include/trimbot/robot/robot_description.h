@@ -57,6 +57,7 @@ class RobotDescription {
   std::vector<std::string> ArmJointNames() const;
   // The collision cylinders of the links the arm's joints move (links 1-6, the cutter's housing
   // included; the blade is the cutter joint's, not among them): what must keep out of the leaves.
+  // Throws InputError naming the file and link when one has no collision cylinder.
   std::vector<LinkCylinder> ArmLinkCylinders() const;
   // The base's outline on the ground: the xy bounding box in base_link (min, max) of the collision
   // geometry of base_link and the wheels (what touches a bush or an obstacle first; the ring and

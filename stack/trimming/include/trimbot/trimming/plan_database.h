@@ -43,8 +43,8 @@ class CuttingPathDatabase {
 
   // The stored path whose target is nearest `target` among those of the same exponents (distance:
   // centres' plus semi-axes' differences plus the yaw's at the mean semi-axis, m, the yaw's modulo
-  // the turns that leave `target`'s shape as it is: any for a round plan); nullptr when the database
-  // holds none of that shape.
+  // the turns that leave the shapes as they are: any for a round plan, within the cut's 2 cm);
+  // nullptr when the database holds none of that shape.
   const StoredCuttingPath* Nearest(const perception::TopiaryShape& target, double* distance = nullptr) const;
 
  private:
