@@ -260,9 +260,9 @@ CutQuality Foliage::Measure(double tolerance) const {
     q.overcut_volume += w * (std::pow(t, 3) - std::pow(std::min(r, t), 3)) / 3.0;
     q.target_volume += w * std::pow(t, 3) / 3.0;
     q.max_overgrowth = std::max(q.max_overgrowth, r - t);
+    if (OnTheGround(static_cast<int>(i), tolerance)) continue;
     // The distance along the target's normal, and the surface element the column's solid angle
     // spans at its radius.
-    if (OnTheGround(static_cast<int>(i), tolerance)) continue;
     const double element = w * r * r / NormalCosine(i);
     const double near = std::abs(SurfaceDistance(static_cast<int>(i))) <= tolerance ? element : 0.0;
     area += element;

@@ -41,6 +41,13 @@ std::optional<Eigen::Vector3d> HalfExtents(const urdf::Geometry& g) {
   return std::nullopt;
 }
 
+// A link's collision geometry when it is a cylinder, else nullptr.
+const urdf::Cylinder* CollisionCylinder(const urdf::LinkConstSharedPtr& link) {
+  return link && link->collision && link->collision->geometry
+             ? dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get())
+             : nullptr;
+}
+
 }  // namespace
 
 Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
@@ -140,9 +147,7 @@ std::vector<LinkCylinder> RobotDescription::ArmLinkCylinders() const {
   std::vector<LinkCylinder> cylinders;
   for (const std::string& joint : ArmJointNames()) {
     const auto link = model_->getLink(model_->getJoint(joint)->child_link_name);
-    const auto* cylinder = link && link->collision && link->collision->geometry
-                               ? dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get())
-                               : nullptr;
+    const urdf::Cylinder* cylinder = CollisionCylinder(link);
     if (cylinder == nullptr) {
       throw InputError(path_,
                        "arm link '" + model_->getJoint(joint)->child_link_name +
@@ -156,10 +161,8 @@ std::vector<LinkCylinder> RobotDescription::ArmLinkCylinders() const {
 }
 
 double RobotDescription::BladeRadius() const {
-  const auto link = model_->getLink(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name);
-  const auto* cylinder = link && link->collision && link->collision->geometry
-                             ? dynamic_cast<const urdf::Cylinder*>(link->collision->geometry.get())
-                             : nullptr;
+  const urdf::Cylinder* cylinder =
+      CollisionCylinder(model_->getLink(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name));
   if (cylinder == nullptr) throw InputError(path_, "the cutter blade's link has no collision cylinder");
   return cylinder->radius;
 }
