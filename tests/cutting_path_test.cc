@@ -298,7 +298,7 @@ double FacingShareWithin2cm(const garden::Foliage& foliage, const Eigen::Vector3
   for (int i = 0; i < foliage.columns(); ++i) {
     if (foliage.direction(i).dot(towards) < 0.5) continue;
     ++count;
-    within += std::abs(foliage.radius(i) - foliage.target_radius(i)) <= 0.02 ? 1 : 0;
+    within += std::abs(foliage.height(i)) <= 0.02 ? 1 : 0;
   }
   return static_cast<double>(within) / count;
 }
@@ -585,12 +585,15 @@ TEST(TrimExecutive, TrimsABoxFromItsCorner) {
   EXPECT_EQ(trim->report().moves_round_the_leaves, 2);
   TrimReplay replay = ReplayTrim(robot, *trim, &foliage);
   std::printf(
-      "box from its corner: %d of %d blade poses reached; within 2 cm %.1f %% -> %.1f %%, over-cut %.2f %%; link "
-      "touches moving in %d, cutting %d, moving out %d\n",
-      trim->report().reached, trim->report().poses, 100.0 * replay.within_before, 100.0 * replay.within_after,
-      100.0 * replay.overcut, replay.touches["moving in"], replay.touches["cutting"], replay.touches["moving out"]);
+      "box from its corner: %d of %d blade poses reached, %d left out, %d turns round the leaves, %d planned round "
+      "the target; within 2 cm %.1f %% -> %.1f %%, over-cut %.2f %%; link touches moving in %d, cutting %d, moving "
+      "out %d\n",
+      trim->report().reached, trim->report().poses, trim->report().left_out, trim->report().turns_round_the_leaves,
+      trim->report().planned_moves, 100.0 * replay.within_before, 100.0 * replay.within_after, 100.0 * replay.overcut,
+      replay.touches["moving in"], replay.touches["cutting"], replay.touches["moving out"]);
   for (const auto& [what, count] : replay.touches_by) std::printf("  %s: %d\n", what.c_str(), count);
   EXPECT_EQ(replay.touches["moving in"], 0);
+  EXPECT_EQ(replay.touches["cutting"], 0) << "the housing turned out of the swath the blade cut";
   EXPECT_EQ(replay.touches["moving out"], 0);
   EXPECT_GT(replay.within_after, replay.within_before + 0.02) << "one corner of four: a few points";
   EXPECT_LT(replay.overcut, 0.01);

@@ -26,19 +26,20 @@ GardenObject Topiary(Shape shape, const Eigen::Vector3d& size) {
   return bush;
 }
 
-// Brute force: the first point along column i, in 1 mm steps, that some position of the disc on
-// its way (1000 steps) holds within half a millimetre of its plane.
+// Brute force: column i's height at the first point from its base, in 1 mm steps, that some
+// position of the disc on its way (1000 steps) holds within half a millimetre of its plane.
 double BruteForceCut(const Foliage& foliage, int i, const BladeDisc& from, const BladeDisc& to) {
   const Eigen::Vector3d axis = from.axis.normalized();
-  for (double s = 0.0; s < foliage.radius(i); s += 0.001) {
-    const Eigen::Vector3d q = foliage.pose() * (s * foliage.direction(i));
+  const double depth = (foliage.root(i) - foliage.base(i)).norm();
+  for (double s = 0.0; s < depth + foliage.height(i); s += 0.001) {
+    const Eigen::Vector3d q = foliage.pose() * (foliage.base(i) + s * foliage.normal(i));
     for (int k = 0; k <= 1000; ++k) {
       const Eigen::Vector3d c = from.centre + (to.centre - from.centre) * (k / 1000.0);
       const Eigen::Vector3d v = q - c;
-      if (std::abs(v.dot(axis)) <= 0.0005 && (v - v.dot(axis) * axis).norm() <= from.radius) return s;
+      if (std::abs(v.dot(axis)) <= 0.0005 && (v - v.dot(axis) * axis).norm() <= from.radius) return s - depth;
     }
   }
-  return foliage.radius(i);
+  return foliage.height(i);
 }
 
 TEST(Foliage, ASweepInItsPlaneSeversEveryColumnItCrossesWhereItCrossesIt) {
@@ -53,17 +54,21 @@ TEST(Foliage, ASweepInItsPlaneSeversEveryColumnItCrossesWhereItCrossesIt) {
   foliage.Cut(from, to);
   int cut = 0;
   for (int i = 0; i < foliage.columns(); ++i) {
-    const Eigen::Vector3d d = foliage.direction(i);
-    double expected = before.radius(i);
-    if (d.z() > 0.0) {
-      // Where the column crosses the disc's plane, and whether the disc's path passed there.
-      const double s = 0.15 / d.z();
-      const Eigen::Vector3d q = foliage.pose() * (s * d);
+    const Eigen::Vector3d base = foliage.base(i), n = foliage.normal(i);
+    const double depth = (foliage.root(i) - base).norm();
+    double expected = before.height(i);
+    if (n.z() > 0.0) {
+      // Where the column's line crosses the disc's plane, and whether the disc's path passed there.
+      const double s = (0.15 - base.z()) / n.z();
+      const Eigen::Vector3d q = foliage.pose() * (base + s * n);
       const double along = std::clamp((q - from.centre).x() / 0.8, 0.0, 1.0);
-      if (s < before.radius(i) && (q - (from.centre + along * (to.centre - from.centre))).norm() <= 0.1) expected = s;
+      if (s >= 0.0 && s - depth < before.height(i) &&
+          (q - (from.centre + along * (to.centre - from.centre))).norm() <= 0.1) {
+        expected = s - depth;
+      }
     }
-    EXPECT_NEAR(foliage.radius(i), expected, 1e-9) << "column " << i;
-    cut += foliage.radius(i) < before.radius(i) ? 1 : 0;
+    EXPECT_NEAR(foliage.height(i), expected, 1e-9) << "column " << i;
+    cut += foliage.height(i) < before.height(i) ? 1 : 0;
   }
   EXPECT_GT(cut, 20) << "the sweep crossed the bush";
   EXPECT_LT(cut, foliage.columns() / 3);
@@ -83,10 +88,27 @@ TEST(Foliage, AnObliqueSweepAgreesWithABruteForceSweep) {
   foliage.Cut(from, to);
   int cut = 0;
   for (int i = 0; i < foliage.columns(); ++i) {
-    EXPECT_NEAR(foliage.radius(i), BruteForceCut(before, i, from, to), 0.004) << "column " << i;
-    cut += foliage.radius(i) < before.radius(i) - 1e-9 ? 1 : 0;
+    EXPECT_NEAR(foliage.height(i), BruteForceCut(before, i, from, to), 0.004) << "column " << i;
+    cut += foliage.height(i) < before.height(i) - 1e-9 ? 1 : 0;
   }
   EXPECT_GT(cut, 5);
+}
+
+// A point is in the foliage when it lies at most its column's height out along the column: just
+// inside and just outside each column's tip, on boxes and on a long ellipsoid whose columns fan out
+// fast at its ends (their lines 16 cm from their common centre of curvature there).
+TEST(Foliage, EveryColumnEndsAtItsTip) {
+  for (const GardenObject& bush :
+       {Topiary(Shape::kEllipsoid, {0.8, 0.6, 0.5}), Topiary(Shape::kBox, {0.8, 0.6, 0.7})}) {
+    const Foliage foliage = Foliage::Grown(bush, 3, 0.6);
+    int wrong = 0;
+    for (int i = 0; i < foliage.columns(); ++i) {
+      if (foliage.OnTheGround(i, 0.004)) continue;  // no leaf below the ground
+      const Eigen::Vector3d tip = foliage.pose() * foliage.tip(i), n = foliage.pose().linear() * foliage.normal(i);
+      wrong += !foliage.Reaches(tip - 0.002 * n) || foliage.Reaches(tip + 0.002 * n) ? 1 : 0;
+    }
+    EXPECT_EQ(wrong, 0) << "of " << foliage.columns() << " columns";
+  }
 }
 
 TEST(Foliage, CuttingOffTheCrownIsMeasuredAsOvercut) {
@@ -110,7 +132,23 @@ TEST(Foliage, CuttingOffTheCrownIsMeasuredAsOvercut) {
   EXPECT_NEAR(capped.overcut_volume, cap, 0.03 * cap);
   EXPECT_LT(capped.overgrowth_volume, grown.overgrowth_volume);
   EXPECT_GT(capped.overgrowth_volume, 0.3 * grown.overgrowth_volume);
-  for (int i = 0; i < foliage.columns(); ++i) EXPECT_LE((foliage.radius(i) * foliage.direction(i)).z(), h + 1e-9);
+  for (int i = 0; i < foliage.columns(); ++i) EXPECT_LE(foliage.tip(i).z(), h + 1e-9);
+  // The drawn surface follows the cut: moved back along its columns, the grown surface lies below
+  // the blade's plane and where it grew below the plane it stays, both but for the columns' 2 deg
+  // grid (a point moved back along its column's normal ends level with the column's tip across
+  // that normal, not across the blade's plane: a step of up to half a cell, 7 mm at 0.4 m, times
+  // the normal's lean off the plane's).
+  const FoliageGrowth growth(bush, 3, 0.6);
+  for (int k = 0; k < 500; ++k) {
+    const double z = 1.0 - (k + 0.5) / 250.0, r = std::sqrt(1.0 - z * z), angle = 2.39996 * k;
+    Eigen::Vector3d p = growth.SurfacePoint({r * std::cos(angle), r * std::sin(angle), z});
+    p.z() = std::max(p.z(), -c);  // as drawn: never below the bottom
+    const Eigen::Vector3d drawn = foliage.CutBack(p);
+    EXPECT_LE(drawn.z(), h + 0.01) << "surface point " << k;
+    if (p.z() < h) {
+      EXPECT_LT((drawn - p).norm(), 0.005) << "surface point " << k;
+    }
+  }
   std::printf("grown: %.1f %% of the surface within 2 cm, %.1f l overgrowth; capped: %.2f l over-cut (cap %.2f l)\n",
               100.0 * grown.surface_within_tolerance, 1000.0 * grown.overgrowth_volume, 1000.0 * capped.overcut_volume,
               1000.0 * cap);
@@ -196,15 +234,42 @@ TEST(Foliage, AHousingBehindABladeThatCutItsWayInIsClearOfTheLeavesBesideItIsNot
   const Eigen::Vector3d side = foliage.pose().linear() * Eigen::Vector3d(0.0, 0.1, 0.0);
   EXPECT_TRUE(foliage.ReachesCylinder(a + side, b + side, 0.03));
   // Only its mantle reaches in when it lies along the surface just outside the leaves' tips.
-  const Eigen::Vector3d tip =
-      foliage.pose() * (foliage.RadiusAlong(Eigen::Vector3d::UnitZ()) * Eigen::Vector3d::UnitZ());
+  int crown = 0;  // the column at the top
+  for (int i = 0; i < foliage.columns(); ++i)
+    crown = foliage.direction(i).z() > foliage.direction(crown).z() ? i : crown;
+  const Eigen::Vector3d tip = foliage.pose() * foliage.tip(crown);
   const Eigen::Vector3d up = foliage.pose().linear() * Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d along = foliage.pose().linear() * Eigen::Vector3d(0.0, 0.06, 0.0);
   EXPECT_TRUE(foliage.ReachesCylinder(tip + 0.02 * up - along, tip + 0.02 * up + along, 0.03));
   double top = 0.0;  // m above the centre: the highest leaf
-  for (int i = 0; i < foliage.columns(); ++i) top = std::max(top, foliage.radius(i) * foliage.direction(i).z());
+  for (int i = 0; i < foliage.columns(); ++i) top = std::max(top, foliage.tip(i).z());
   const Eigen::Vector3d above = foliage.pose() * Eigen::Vector3d(0.0, 0.0, top + 0.04);
   EXPECT_FALSE(foliage.ReachesCylinder(above - along, above + along, 0.03)) << "1 cm above the highest leaf";
+}
+
+// Leaves grow out along the target's normal: near a box's corner, a blade plunged along a face's
+// normal to the target clears the housing behind it (radial columns from the centre lean 30 deg
+// off that normal there: leaves rooted beside the blade's swath would hang over its housing).
+TEST(Foliage, AHousingBehindABladePlungedNearABoxCornerIsClearOfTheLeaves) {
+  const GardenObject bush = Topiary(Shape::kBox, {0.8, 0.8, 0.7});
+  Foliage foliage = Foliage::Grown(bush, 6, 0.5);
+  for (const Eigen::Vector3d& on_face :
+       {Eigen::Vector3d(0.4, 0.25, 0.2), Eigen::Vector3d(0.4, -0.28, 0.22), Eigen::Vector3d(0.3, 0.3, 0.35)}) {
+    Foliage cut = foliage;
+    const Eigen::Vector3d surface = cut.target().Radius(on_face.normalized()) * on_face.normalized();
+    const Eigen::Vector3d n = cut.target().Normal(surface);
+    const Eigen::Vector3d out = cut.pose().linear() * n, at = cut.pose() * surface;
+    BladeDisc from, to;
+    from.centre = at + 0.2 * out;
+    to.centre = at;
+    from.axis = to.axis = out;
+    from.radius = to.radius = 0.05;
+    const Eigen::Vector3d a = at + 0.01 * out, b = a + 0.13 * out;
+    EXPECT_TRUE(cut.ReachesCylinder(a, b, 0.03)) << "the leaves stand there before the cut";
+    cut.Cut(from, to);
+    EXPECT_FALSE(cut.ReachesCylinder(a, b, 0.03)) << "housing behind the blade at " << on_face.transpose();
+    EXPECT_TRUE(cut.ReachesCylinder(a, b, 0.06)) << "leaves just beyond the blade's 5 cm stand";
+  }
 }
 
 TEST(Foliage, WritesItsSurfaceAsPly) {

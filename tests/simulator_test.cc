@@ -263,7 +263,7 @@ garden::Foliage SweepThroughATopiary(bool cutter_on, long* blade_cuts) {
   *blade_cuts = offline.cut_columns();
   EXPECT_EQ(simulator.foliage(2), nullptr) << "only the trimmed bush is cuttable";
   int differing = 0;
-  for (int i = 0; i < offline.columns(); ++i) differing += simulator.foliage(1)->radius(i) != offline.radius(i);
+  for (int i = 0; i < offline.columns(); ++i) differing += simulator.foliage(1)->height(i) != offline.height(i);
   EXPECT_EQ(differing, 0) << "columns the simulator cut otherwise than the blade's sweep";
   return *simulator.foliage(1);
 }

@@ -130,14 +130,18 @@ FoliageGrowth::FoliageGrowth(const GardenObject& object, std::uint64_t appearanc
       clump_scale_(object.object_class == ObjectClass::kTree ? 0.4 : 0.12),
       growth_(IsFoliage(object.object_class) ? growth : 0.0) {}
 
-Eigen::Vector3d FoliageGrowth::SurfacePoint(const Eigen::Vector3d& d) const {
+double FoliageGrowth::Outgrowth(const Eigen::Vector3d& d) const {
   const Eigen::Vector3d surface = d * target_.Radius(d);
   const double clumps =
       ValueNoise(seed_, surface / clump_scale_) * 0.7 + ValueNoise(seed_ + 1, surface / (clump_scale_ * 0.4)) * 0.3;
   // Outgrowth in patches of ~30 cm shoots.
   const double shoots = std::max(0.0, ValueNoise(seed_ + 2, surface / 0.3));
-  const double outward = clump_depth_ * clumps + growth_ * kMaxGrowth * (0.4 + 1.2 * shoots);
-  return surface + d * outward;
+  return clump_depth_ * clumps + growth_ * kMaxGrowth * (0.4 + 1.2 * shoots);
+}
+
+Eigen::Vector3d FoliageGrowth::SurfacePoint(const Eigen::Vector3d& d) const {
+  const Eigen::Vector3d surface = d * target_.Radius(d);
+  return surface + target_.Normal(surface) * Outgrowth(d);
 }
 
 Foliage Foliage::Grown(const GardenObject& object, std::uint64_t appearance_seed, double growth, int rings,
@@ -153,13 +157,16 @@ Foliage Foliage::Grown(const GardenObject& object, std::uint64_t appearance_seed
   for (int r = 0; r < rings; ++r) {
     for (int s = 0; s < segments; ++s) {
       const Eigen::Vector3d d = CellDirection(r, s, rings, segments);
+      const Eigen::Vector3d root = foliage.target_.Radius(d) * d, normal = foliage.target_.Normal(root);
       // Never below the shape's bottom (it sits on the ground or its stem).
-      const double floor = d.z() < 0.0 ? foliage.target_.half.z() / -d.z() : kNoCut;
+      const double floor = normal.z() < 0.0 ? (root.z() + foliage.target_.half.z()) / -normal.z() : kNoCut;
       foliage.direction_.push_back(d);
       foliage.solid_angle_.push_back(CellSolidAngle(r, rings, segments));
-      foliage.radius_.push_back(std::min(grown.SurfacePoint(d).dot(d), floor));
-      foliage.target_radius_.push_back(std::min(foliage.target_.Radius(d), floor));
-      foliage.floor_radius_.push_back(floor);
+      foliage.root_.push_back(root);
+      foliage.normal_.push_back(normal);
+      foliage.height_.push_back(std::min(grown.Outgrowth(d), floor));
+      foliage.floor_height_.push_back(floor);
+      foliage.reach_ = std::max(foliage.reach_, foliage.tip(foliage.columns() - 1).norm());
     }
   }
   return foliage;
@@ -167,40 +174,105 @@ Foliage Foliage::Grown(const GardenObject& object, std::uint64_t appearance_seed
 
 void Foliage::CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& axis,
                             double radius) {
-  // Columns are rays from the centre: work in the centre frame.
   const Eigen::Isometry3d T_centre_map = T_map_centre_.inverse();
   const Eigen::Vector3d a = T_centre_map * from, b = T_centre_map * to;
   const Eigen::Vector3d n = (T_centre_map.linear() * axis).normalized();
-  const Eigen::Vector3d root(0.0, 0.0, -target_.half.z());  // the stem, at the shape's bottom
-  double reach = 0.0;
-  for (double r : radius_) reach = std::max(reach, r);
+  const Eigen::Vector3d stem(0.0, 0.0, -target_.half.z());  // at the shape's bottom
   // Nothing to cut when the swept disc stays beyond every column's end.
   const Eigen::Vector3d ab = b - a;
   const double t = ab.squaredNorm() > 0.0 ? std::clamp(-a.dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-  if ((a + t * ab).norm() > reach + radius) return;
-  for (std::size_t i = 0; i < radius_.size(); ++i) {
-    const double s = FirstCrossing(direction_[i], radius_[i], a, b, n, radius, root);
-    if (s < radius_[i]) {
-      radius_[i] = s;
+  if ((a + t * ab).norm() > reach_ + radius) return;
+  for (std::size_t i = 0; i < height_.size(); ++i) {
+    // Along the column's line from its base, where the crossing is measured.
+    const double depth = root_[i].dot(normal_[i]), length = depth + height_[i];
+    const Eigen::Vector3d base = root_[i] - depth * normal_[i];
+    const double s = FirstCrossing(normal_[i], length, a - base, b - base, n, radius, stem - base);
+    if (s < length) {
+      height_[i] = s - depth;
       ++cut_columns_;
     }
   }
+  reach_ = 0.0;
+  for (int i = 0; i < columns(); ++i) reach_ = std::max(reach_, tip(i).norm());
 }
 
-double Foliage::RadiusAlong(const Eigen::Vector3d& direction) const {
-  const Eigen::Vector3d d = direction.normalized();
-  const double polar = std::acos(std::clamp(d.z(), -1.0, 1.0));
-  double azimuth = std::atan2(d.y(), d.x());
+int Foliage::CellOf(const Eigen::Vector3d& p) const {
+  const double polar = std::acos(std::clamp(p.z() / p.norm(), -1.0, 1.0));
+  double azimuth = std::atan2(p.y(), p.x());
   if (azimuth < 0.0) azimuth += 2.0 * M_PI;
   const int r = std::clamp(static_cast<int>(polar / M_PI * rings_), 0, rings_ - 1);
   const int s = static_cast<int>(azimuth / (2.0 * M_PI) * segments_) % segments_;
-  return radius_[static_cast<std::size_t>(r * segments_ + s)];
+  return r * segments_ + s;
+}
+
+int Foliage::ColumnOf(const Eigen::Vector3d& p) const {
+  // p's squared distance from column i's line.
+  const auto off_line = [&](int i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Eigen::Vector3d v = p - root_[k];
+    const double along = v.dot(normal_[k]);
+    return v.squaredNorm() - along * along;
+  };
+  // A first step to the cell under p's foot on the tangent plane of p's own cell: the lines fan
+  // out from a curved target, so such steps overshoot (by 1 + height x curvature, near 2 at a
+  // long ellipsoid's ends) and can swing to and fro; the rest downhill over neighbouring cells.
+  int i = CellOf(p);
+  const auto k = static_cast<std::size_t>(i);
+  const Eigen::Vector3d foot = p - (p - root_[k]).dot(normal_[k]) * normal_[k];
+  if (foot.squaredNorm() > 1e-18) {
+    const int j = CellOf(foot);
+    if (off_line(j) < off_line(i)) i = j;
+  }
+  constexpr int kMaxSteps = 32;  // cells; seen: 0-3
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const int ring = i / segments_, segment = i % segments_;
+    int best = i;
+    double best_off = off_line(i);
+    for (int dr = -1; dr <= 1; ++dr) {
+      for (int ds = -1; ds <= 1; ++ds) {
+        int r = ring + dr, s = segment + ds;
+        if (r < 0 || r >= rings_) {  // over the pole: the ring itself, half round
+          r = ring;
+          s += segments_ / 2;
+        }
+        const int n = r * segments_ + (s + segments_) % segments_;
+        const double off = off_line(n);
+        if (off < best_off) {
+          best = n;
+          best_off = off;
+        }
+      }
+    }
+    if (best == i) break;
+    i = best;
+  }
+  return i;
 }
 
 bool Foliage::Reaches(const Eigen::Vector3d& point) const {
   const Eigen::Vector3d p = T_map_centre_.inverse() * point;
   const double distance = p.norm();
-  return distance < 1e-9 || distance <= RadiusAlong(p / distance);
+  if (distance < 1e-9) return true;
+  if (distance > reach_) return false;
+  const auto i = static_cast<std::size_t>(ColumnOf(p));
+  return (p - root_[i]).dot(normal_[i]) <= height_[i];
+}
+
+Eigen::Vector3d Foliage::CutBack(const Eigen::Vector3d& p) const {
+  if (p.squaredNorm() < 1e-18) return p;
+  const auto i = static_cast<std::size_t>(ColumnOf(p));
+  const double excess = (p - root_[i]).dot(normal_[i]) - height_[i];
+  return excess > 0.0 ? Eigen::Vector3d(p - excess * normal_[i]) : p;
+}
+
+double Foliage::ExitRadius(const Eigen::Vector3d& d) const {
+  // Bisection between the centre (in the foliage) and just past the farthest tip (outside it).
+  double in = 0.0, out = reach_ + 0.01;
+  for (int k = 0; k < 24; ++k) {  // 1 m / 2^24: well under a micrometre
+    const double s = 0.5 * (in + out);
+    (Reaches(T_map_centre_ * (s * d)) ? in : out) = s;
+  }
+  return in;
 }
 
 bool Foliage::ReachesCylinder(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const {
@@ -241,30 +313,23 @@ void Foliage::Cut(const BladeDisc& from, const BladeDisc& to) {
   }
 }
 
-double Foliage::NormalCosine(std::size_t i) const {
-  const Eigen::Vector3d& d = direction_[i];
-  return std::max(0.1, std::abs(d.dot(target_.Normal(target_radius_[i] * d))));
-}
-
-double Foliage::SurfaceDistance(int i) const {
-  const auto k = static_cast<std::size_t>(i);
-  return (radius_[k] - target_radius_[k]) * NormalCosine(k);
-}
+double Foliage::NormalCosine(std::size_t i) const { return std::max(0.1, std::abs(direction_[i].dot(normal_[i]))); }
 
 CutQuality Foliage::Measure(double tolerance) const {
   CutQuality q;
   double area = 0.0, within = 0.0, upper_area = 0.0, upper_within = 0.0;
-  for (std::size_t i = 0; i < radius_.size(); ++i) {
-    const double r = radius_[i], t = target_radius_[i], w = solid_angle_[i];
+  for (std::size_t i = 0; i < height_.size(); ++i) {
+    const int column = static_cast<int>(i);
+    const double r = ExitRadius(direction_[i]), t = root_[i].norm(), w = solid_angle_[i];
     q.overgrowth_volume += w * (std::pow(std::max(r, t), 3) - std::pow(t, 3)) / 3.0;
     q.overcut_volume += w * (std::pow(t, 3) - std::pow(std::min(r, t), 3)) / 3.0;
     q.target_volume += w * std::pow(t, 3) / 3.0;
-    q.max_overgrowth = std::max(q.max_overgrowth, r - t);
-    if (OnTheGround(static_cast<int>(i), tolerance)) continue;
-    // The distance along the target's normal, and the surface element the column's solid angle
-    // spans at its radius.
-    const double element = w * r * r / NormalCosine(i);
-    const double near = std::abs(SurfaceDistance(static_cast<int>(i))) <= tolerance ? element : 0.0;
+    q.max_overgrowth = std::max(q.max_overgrowth, height_[i]);
+    if (OnTheGround(column, tolerance)) continue;
+    // The surface element the column's cell spans at its tip's distance from the centre, tilted
+    // by the normal's lean off the cell's direction (on a ball: the cell's area at the tip).
+    const double element = w * tip(column).squaredNorm() / NormalCosine(i);
+    const double near = std::abs(height_[i]) <= tolerance ? element : 0.0;
     area += element;
     within += near;
     if (direction_[i].z() >= 0.0) {
@@ -279,21 +344,20 @@ CutQuality Foliage::Measure(double tolerance) const {
 
 std::vector<Eigen::Vector3d> Foliage::SurfacePoints() const {
   std::vector<Eigen::Vector3d> points;
-  points.reserve(radius_.size());
-  for (std::size_t i = 0; i < radius_.size(); ++i) points.push_back(T_map_centre_ * (radius_[i] * direction_[i]));
+  points.reserve(height_.size());
+  for (int i = 0; i < columns(); ++i) points.push_back(T_map_centre_ * tip(i));
   return points;
 }
 
 void Foliage::WritePly(const std::string& path) const {
   std::ostringstream out;
   out << "ply\nformat binary_little_endian 1.0\ncomment trimbot foliage: leaf surface, map frame, m\n"
-      << "element vertex " << radius_.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element vertex " << height_.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property float distance\nend_header\n";
   const std::vector<Eigen::Vector3d> points = SurfacePoints();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const float values[4] = {static_cast<float>(points[i].x()), static_cast<float>(points[i].y()),
-                             static_cast<float>(points[i].z()),
-                             static_cast<float>(SurfaceDistance(static_cast<int>(i)))};
+                             static_cast<float>(points[i].z()), static_cast<float>(height_[i])};
     char bytes[sizeof(values)];
     std::memcpy(bytes, values, sizeof(values));  // little-endian hosts only (x86-64, arm64)
     out.write(bytes, sizeof(bytes));

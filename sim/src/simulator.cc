@@ -232,11 +232,7 @@ void Simulator::DrawCutFoliage() {
     topiary.drawn_cuts = topiary.foliage.cut_columns();
     std::vector<float> vertices(3 * topiary.rest_in_centre.size());
     for (std::size_t v = 0; v < topiary.rest_in_centre.size(); ++v) {
-      const Eigen::Vector3d& rest = topiary.rest_in_centre[v];
-      const double r = rest.norm();
-      const Eigen::Vector3d now =
-          topiary.T_mesh_centre *
-          (r > 0.0 ? Eigen::Vector3d(rest * std::min(1.0, topiary.foliage.RadiusAlong(rest) / r)) : rest);
+      const Eigen::Vector3d now = topiary.T_mesh_centre * topiary.foliage.CutBack(topiary.rest_in_centre[v]);
       for (int k = 0; k < 3; ++k) vertices[3 * v + static_cast<std::size_t>(k)] = static_cast<float>(now[k]);
     }
     // A plant that sways sways about its cut shape.

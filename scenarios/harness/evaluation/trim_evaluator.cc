@@ -105,6 +105,8 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.nearest_neighbour_seconds = report.nearest_neighbour_time;
   o.leaf_depth_m = report.leaf_depth;
   o.moves_round_the_leaves = report.moves_round_the_leaves;
+  o.poses_left_out = report.left_out;
+  o.turns_round_the_leaves = report.turns_round_the_leaves;
   trim->planning_seconds = report.planning_seconds;
   if (trim->started >= 0.0) {
     trim->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trim->wall_started).count();

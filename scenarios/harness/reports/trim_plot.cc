@@ -25,8 +25,7 @@ cv::Mat DistanceMap(const garden::Foliage& foliage, const std::string& title) {
   for (int i = 0; i < foliage.columns(); ++i) {
     const int row = i / foliage.segments(), column = i % foliage.segments();
     cv::rectangle(image, cv::Rect(column * kScale, top + row * kScale, kScale, kScale),
-                  foliage.OnTheGround(i, kTolerance) ? kOnTheGround : DistanceColour(foliage.SurfaceDistance(i)),
-                  cv::FILLED);
+                  foliage.OnTheGround(i, kTolerance) ? kOnTheGround : DistanceColour(foliage.height(i)), cv::FILLED);
   }
   PutText(image, title, {6, 20}, 0.5, kInk);
   return image;

@@ -54,6 +54,8 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
     : parameters_(parameters),
       kinematics_(description),
       T_cutter_blade_(description.BladeInCutter()),
+      blade_radius_(description.BladeRadius()),
+      housing_radius_(description.ArmLinkCylinders().back().radius),  // link 6 carries the cutter
       collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
       planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
   // One speed model for the path's costs and the trajectory that executes it.
@@ -257,61 +259,122 @@ void TrimExecutive::Plan(double stamp) {
 }
 
 std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, std::string* failure) {
-  std::vector<Eigen::VectorXd> waypoints{path.configurations.front()};
-  for (std::size_t i = 0; i + 1 < path.configurations.size(); ++i) {
-    // In from the start and out back to it: round the leaves.
-    const bool in = i == 0, out = i + 2 == path.configurations.size();
-    if (i == 1) first_blade_waypoint_ = waypoints.size() - 1;
-    if (out) last_blade_waypoint_ = waypoints.size() - 1;
-    const Eigen::VectorXd from = waypoints.back();
-    const Eigen::VectorXd to = from + kinematics_.JointDifference(from, path.configurations[i + 1]);
-    if (!path.planned[i]) {
-      waypoints.push_back(to);
-      continue;
-    }
-    if (in || out) {
-      std::vector<Eigen::VectorXd> way = in ? IntoTheLeaves(from, to) : IntoTheLeaves(to, from);
-      if (!way.empty()) {
-        if (out) way = BeginningAt({way.rbegin(), way.rend()}, from);
-        waypoints.insert(waypoints.end(), way.begin() + 1, way.end());
-        ++report_.moves_round_the_leaves;
-        continue;
-      }
-    }
-    const arm::ArmPlan plan = planner_->PlanToJoints(from, to);
+  const std::vector<Eigen::VectorXd>& q = path.configurations;  // the start, the blade poses, the start
+  const std::size_t last = q.size() - 2;                        // the last blade pose
+  // In round the leaves to the first blade pose that has such a way, out from the last: the poses
+  // before and after those are left out (a blade pose hard against the base cannot be drawn back
+  // along its axis), at most kMaxLeftOut at either end; beyond that the move goes round the shrunk
+  // target as any other planned move, through the leaves.
+  constexpr std::size_t kMaxLeftOut = 3;
+  const auto way_round = [&](std::size_t k) {
+    return IntoTheLeaves(q.front(), q.front() + kinematics_.JointDifference(q.front(), q[k]));
+  };
+  std::size_t first = 1, final = last;
+  std::vector<Eigen::VectorXd> in, out;
+  for (std::size_t k = 1; k <= std::min(last, 1 + kMaxLeftOut) && in.empty(); ++k) {
+    in = way_round(k);
+    if (!in.empty()) first = k;
+  }
+  for (std::size_t k = last; k >= first && k + kMaxLeftOut >= last && out.empty(); --k) {
+    out = way_round(k);
+    if (!out.empty()) final = k;
+    if (k == first) break;
+  }
+  report_.left_out = static_cast<int>((first - 1) + (last - final));
+  std::vector<Eigen::VectorXd> waypoints{q.front()};
+  const auto append = [&](const std::vector<Eigen::VectorXd>& way) {
+    waypoints.insert(waypoints.end(), way.begin() + 1, way.end());
+  };
+  const auto plan_round_target = [&](const Eigen::VectorXd& to, std::size_t pose) {
+    const arm::ArmPlan plan = planner_->PlanToJoints(waypoints.back(), to);
     if (!plan.ok) {
-      *failure = "no move round the target from blade pose " + std::to_string(i) + " to the next: " + plan.failure;
+      *failure = "no move round the target from blade pose " + std::to_string(pose) + " to the next: " + plan.failure;
+      return false;
+    }
+    append(plan.waypoints);
+    ++report_.planned_moves;
+    return true;
+  };
+  if (!in.empty()) {
+    append(in);
+    ++report_.moves_round_the_leaves;
+  } else if (!plan_round_target(q.front() + kinematics_.JointDifference(q.front(), q[first]), 0)) {
+    return {};
+  }
+  first_blade_waypoint_ = waypoints.size() - 1;
+  for (std::size_t i = first; i < final; ++i) {
+    const Eigen::VectorXd to = waypoints.back() + kinematics_.JointDifference(waypoints.back(), q[i + 1]);
+    // A straight move that keeps the blade's turn small stays in the swath it cuts; any other goes
+    // out along the axis, round the leaves and in (where it can), not through them.
+    const bool straight = !path.planned[i];
+    std::vector<Eigen::VectorXd> way;
+    if (!straight || BladeTurn(waypoints.back(), to) > MaxTurnInLeaves()) way = RoundTheLeaves(waypoints.back(), to);
+    if (!way.empty()) {
+      append(way);
+      ++report_.turns_round_the_leaves;
+    } else if (straight) {
+      waypoints.push_back(to);
+    } else if (!plan_round_target(to, i)) {
       return {};
     }
-    waypoints.insert(waypoints.end(), plan.waypoints.begin() + 1, plan.waypoints.end());
-    ++report_.planned_moves;
+  }
+  last_blade_waypoint_ = waypoints.size() - 1;
+  if (!out.empty()) {
+    append(BeginningAt({out.rbegin(), out.rend()}, waypoints.back()));
+    ++report_.moves_round_the_leaves;
+  } else if (!plan_round_target(waypoints.back() + kinematics_.JointDifference(waypoints.back(), q.back()), final)) {
+    return {};
   }
   return waypoints;
 }
 
-std::vector<Eigen::VectorXd> TrimExecutive::IntoTheLeaves(const Eigen::VectorXd& outside,
-                                                          const Eigen::VectorXd& at_blade) {
-  // Drawn back along the blade's axis past the leaves: from blade_depth inside the fit to
-  // leaf_clearance beyond the leaves' depth, and the disc's thickness.
+std::vector<Eigen::VectorXd> TrimExecutive::DrawnBack(const Eigen::VectorXd& at_blade) {
+  // From blade_depth inside the fit to leaf_clearance beyond the leaves' depth, and the disc's
+  // thickness.
   const Eigen::Isometry3d cutter = kinematics_.EndEffectorPose(at_blade);
   const Eigen::Vector3d into = cutter.linear() * T_cutter_blade_.linear().col(2);
   constexpr double kDiscClearance = 0.01;  // m
   Eigen::Isometry3d back = cutter;
   back.translation() -=
       (parameters_.blade_depth + report_.leaf_depth + parameters_.leaf_clearance + kDiscClearance) * into;
-  const arm::ArmPlan drawn_back = planner_->CartesianPass(at_blade, back);  // within the shrunk target's
-  if (!drawn_back.ok) return {};
+  const arm::ArmPlan pass = planner_->CartesianPass(at_blade, back);  // within the shrunk target's
+  return pass.ok ? pass.waypoints : std::vector<Eigen::VectorXd>{};
+}
+
+std::vector<Eigen::VectorXd> TrimExecutive::IntoTheLeaves(const Eigen::VectorXd& outside,
+                                                          const Eigen::VectorXd& at_blade) {
+  const std::vector<Eigen::VectorXd> drawn_back = DrawnBack(at_blade);
+  if (drawn_back.empty()) return {};
   SetTargetEnvironment(collision_.get(), target_shape_, report_.leaf_depth + parameters_.leaf_clearance);
   planner_->ResetRoadmap();
-  const arm::ArmPlan round = planner_->PlanToJoints(outside, drawn_back.waypoints.back());
+  const arm::ArmPlan round = planner_->PlanToJoints(outside, drawn_back.back());
   SetTargetEnvironment(collision_.get(), target_shape_, -parameters_.tolerance);
   planner_->ResetRoadmap();
   if (!round.ok) return {};
   std::vector<Eigen::VectorXd> way = round.waypoints;
-  const std::vector<Eigen::VectorXd> in =
-      BeginningAt({drawn_back.waypoints.rbegin(), drawn_back.waypoints.rend()}, way.back());
+  const std::vector<Eigen::VectorXd> in = BeginningAt({drawn_back.rbegin(), drawn_back.rend()}, way.back());
   way.insert(way.end(), in.begin() + 1, in.end());
   return way;
+}
+
+std::vector<Eigen::VectorXd> TrimExecutive::RoundTheLeaves(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
+  std::vector<Eigen::VectorXd> way = DrawnBack(from);
+  if (way.empty()) return {};
+  const std::vector<Eigen::VectorXd> in = IntoTheLeaves(way.back(), to);
+  if (in.empty()) return {};
+  way.insert(way.end(), in.begin() + 1, in.end());
+  return way;
+}
+
+double TrimExecutive::MaxTurnInLeaves() const {
+  const double height = parameters_.blade_depth + report_.leaf_depth;
+  return height > blade_radius_ - housing_radius_ ? std::asin((blade_radius_ - housing_radius_) / height) : M_PI;
+}
+
+double TrimExecutive::BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
+  const Eigen::Vector3d a = (kinematics_.EndEffectorPose(from) * T_cutter_blade_).linear().col(2);
+  const Eigen::Vector3d b = (kinematics_.EndEffectorPose(to) * T_cutter_blade_).linear().col(2);
+  return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
 }
 
 void TrimExecutive::Finish(double stamp, const std::string& failure) {

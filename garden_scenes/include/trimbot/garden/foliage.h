@@ -2,9 +2,12 @@
 // A topiary's foliage as ground truth that can be cut. The target is the trimmed shape of the
 // garden file (a superellipsoid: a ball or ellipsoid, a rounded cylinder, a rounded box); the
 // leaves lie on a surface displaced from it by leaf clumps and by the season's outgrowth (the
-// surface ObjectMesh renders). Foliage keeps that surface as a radial height field over directions
-// from the shape's centre: each direction is a column of foliage from the centre out to its radius.
-// A blade disc sweeping through a column severs what lies beyond, so cutting shortens columns;
+// surface ObjectMesh renders). Foliage keeps that surface as a height field over the target: a
+// column of foliage stands on the target at each of a grid of directions from the shape's centre
+// and runs along the target's normal there, as shoots grow out of a clipped surface. (Columns
+// running radially from the centre would lean 30-40 deg off a box's face near its corners: leaves
+// rooted beside a blade's swath would hang over it, where nothing grows.) A blade disc sweeping
+// through a column severs what lies beyond, so cutting shortens columns;
 // what stays is measured against the target as van Marrewijk et al. (Biosystems Engineering 214,
 // 2022) measured the robot's cuts: the share of the surface within 2 cm of the target.
 #include <Eigen/Geometry>
@@ -40,7 +43,11 @@ Superellipsoid TargetShape(const GardenObject& object);
 class FoliageGrowth {
  public:
   FoliageGrowth(const GardenObject& object, std::uint64_t appearance_seed, double growth);
-  Eigen::Vector3d SurfacePoint(const Eigen::Vector3d& direction) const;  // in the shape's centre frame
+  // How far the leaves stand out along the target's normal where a ray from the centre along the
+  // unit `direction` meets the target (m; negative where a clump dips below it).
+  double Outgrowth(const Eigen::Vector3d& direction) const;
+  // That leaf surface point, in the shape's centre frame.
+  Eigen::Vector3d SurfacePoint(const Eigen::Vector3d& direction) const;
   const Superellipsoid& target() const { return target_; }
 
  private:
@@ -67,7 +74,7 @@ struct CutQuality {
   double overgrowth_volume = 0.0;  // m^3 of foliage outside the target
   double overcut_volume = 0.0;     // m^3 of the target without foliage (cut into)
   double target_volume = 0.0;      // m^3
-  double max_overgrowth = 0.0;     // m: the largest radial excess over the target
+  double max_overgrowth = 0.0;     // m: the highest column over the target
 };
 
 class Foliage {
@@ -81,7 +88,8 @@ class Foliage {
   // crosses ends where the blade first met it.
   void Cut(const BladeDisc& from, const BladeDisc& to);
 
-  // Against the target, the surface's distance measured along the target's normal.
+  // Against the target: each column's height is the surface's distance along the target's normal;
+  // the volumes integrate where the foliage ends along rays from the centre.
   CutQuality Measure(double tolerance = 0.02) const;
   // The leaf surface's points in the map frame (one per column).
   std::vector<Eigen::Vector3d> SurfacePoints() const;
@@ -89,11 +97,12 @@ class Foliage {
   // property `distance`), written atomically.
   void WritePly(const std::string& path) const;
 
-  // Where the foliage ends along a unit direction from the centre (centre frame): the nearest
-  // column's radius.
-  double RadiusAlong(const Eigen::Vector3d& direction) const;
-  // Whether a map point lies inside the foliage.
+  // Whether a map point lies inside the foliage: at most its column's height above the target,
+  // its column being the one whose line passes through it (nearest the target's point under it).
   bool Reaches(const Eigen::Vector3d& point) const;
+  // A point of the foliage as grown (centre frame) moved in along its column to where cuts have
+  // left the column's leaves; unchanged where it lies below them (the drawn mesh follows the cuts).
+  Eigen::Vector3d CutBack(const Eigen::Vector3d& point) const;
   // Whether a solid cylinder (axis end points `a`, `b` in the map frame, `radius`) reaches into the
   // foliage: its axis, its mantle and its end caps sampled every centimetre. A point test with the
   // radius as a margin along the ray from the bush's centre would not do: it counts an end cap just
@@ -102,21 +111,23 @@ class Foliage {
   // Columns shortened by cuts so far (a drawing of the foliage is stale when it grew).
   long cut_columns() const { return cut_columns_; }
 
-  // Column i's end from the target, along the target's normal (m; outside > 0).
-  double SurfaceDistance(int i) const;
-  // Whether the ground plane the shape stands on lies within `tolerance` of column i's target,
-  // along the column (no leaf grows out there: Measure leaves it out).
-  bool OnTheGround(int i, double tolerance) const {
-    const auto k = static_cast<std::size_t>(i);
-    return floor_radius_[k] - target_radius_[k] < tolerance;
-  }
+  // Whether the ground plane the shape stands on lies within `tolerance` of column i's root, along
+  // the column (no leaf grows out there: Measure leaves it out).
+  bool OnTheGround(int i, double tolerance) const { return floor_height_[static_cast<std::size_t>(i)] < tolerance; }
 
-  int columns() const { return static_cast<int>(radius_.size()); }
+  // Column i (all in the centre frame): it stands on the target at `root`, where a ray from the
+  // centre along `direction` meets it, and runs along the target's outward unit `normal` there,
+  // from its `base` (the line's point nearest the centre) to its `tip`, `height` m beyond the
+  // target (negative: cut into it).
+  int columns() const { return static_cast<int>(height_.size()); }
   int rings() const { return rings_; }  // columns are ring-major: i = ring * segments + segment
   int segments() const { return segments_; }
   const Eigen::Vector3d& direction(int i) const { return direction_[static_cast<std::size_t>(i)]; }
-  double radius(int i) const { return radius_[static_cast<std::size_t>(i)]; }
-  double target_radius(int i) const { return target_radius_[static_cast<std::size_t>(i)]; }
+  const Eigen::Vector3d& root(int i) const { return root_[static_cast<std::size_t>(i)]; }
+  const Eigen::Vector3d& normal(int i) const { return normal_[static_cast<std::size_t>(i)]; }
+  double height(int i) const { return height_[static_cast<std::size_t>(i)]; }
+  Eigen::Vector3d base(int i) const { return root(i) - root(i).dot(normal(i)) * normal(i); }
+  Eigen::Vector3d tip(int i) const { return root(i) + height(i) * normal(i); }
   const Superellipsoid& target() const { return target_; }
   // Pose of the shape's centre frame in the map frame.
   const Eigen::Isometry3d& pose() const { return T_map_centre_; }
@@ -124,19 +135,26 @@ class Foliage {
  private:
   void CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& axis,
                      double radius);
-  // |cos| of the angle between column i and the target's normal where it crosses the target (at
-  // least 0.1): the radial excess times it is the distance along the normal.
+  // The column of the cell a ray from the centre through p (centre frame) crosses.
+  int CellOf(const Eigen::Vector3d& p) const;
+  // The column whose line passes nearest p (centre frame; through it but for the grid).
+  int ColumnOf(const Eigen::Vector3d& p) const;
+  // Where the foliage ends along a ray from the centre (unit `direction`, centre frame).
+  double ExitRadius(const Eigen::Vector3d& direction) const;
+  // |cos| of the angle between column i's direction from the centre and its normal (at least 0.1).
   double NormalCosine(std::size_t i) const;
 
   Superellipsoid target_;
   int rings_ = 0, segments_ = 0;
   long cut_columns_ = 0;
+  double reach_ = 0.0;  // m: the farthest tip from the centre (nothing beyond is foliage)
   Eigen::Isometry3d T_map_centre_ = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3d> direction_;  // unit, in the centre frame
   std::vector<double> solid_angle_;         // sr per column
-  std::vector<double> radius_;              // m: where the foliage ends
-  std::vector<double> target_radius_;       // m: where the target's surface is
-  std::vector<double> floor_radius_;        // m: the bottom plane along the column (foliage never below)
+  std::vector<Eigen::Vector3d> root_;       // where the column meets the target
+  std::vector<Eigen::Vector3d> normal_;     // the target's outward unit normal there
+  std::vector<double> height_;              // m along the normal: where the foliage ends
+  std::vector<double> floor_height_;        // m along the normal: the bottom plane (foliage never below)
 };
 
 }  // namespace trimbot::garden

@@ -79,6 +79,10 @@ struct TrimReport {
   double leaf_depth = 0.0;              // m: the leaves outside the fit, as the scan saw them (leaf_quantile)
   int moves_round_the_leaves = 0;       // of the moves in and out (2 at most): round the leaves, then along the
                                         // blade's axis (the others round the shrunk target only: no such way found)
+  int left_out = 0;                     // blade poses at the path's ends left out: no way in or out round the leaves
+  int turns_round_the_leaves = 0;       // moves between blade poses out along the axis, round the leaves and in:
+                                        // those that turn the blade too far to stay in the swath it cuts
+                                        // (MaxTurnInLeaves) and those a straight move was refused
 };
 
 class TrimExecutive {
@@ -139,10 +143,24 @@ class TrimExecutive {
   // `outside`; ends where `at_blade` puts the blade (continuous joints maybe a turn off); empty
   // when there is no such way.
   std::vector<Eigen::VectorXd> IntoTheLeaves(const Eigen::VectorXd& outside, const Eigen::VectorXd& at_blade);
+  // From blade pose `from` to blade pose `to`: drawn back out along the blade's axis, then
+  // IntoTheLeaves; empty when there is no such way.
+  std::vector<Eigen::VectorXd> RoundTheLeaves(const Eigen::VectorXd& from, const Eigen::VectorXd& to);
+  // The blade pose drawn back along its axis past the leaves the scan saw (a Cartesian pass from
+  // `at_blade`); empty when the pass is not free.
+  std::vector<Eigen::VectorXd> DrawnBack(const Eigen::VectorXd& at_blade);
+  // The largest turn of the blade between two poses that keeps the housing in the swath the disc
+  // cuts: turning by a about the disc's centre moves the housing's mantle sideways by h sin(a) at
+  // height h over the disc, and the leaves stand up to blade_depth + leaf_depth over it; the
+  // housing (r_h) stays within the disc (r_b) while that is at most r_b - r_h.
+  double MaxTurnInLeaves() const;
+  // The angle between the blade's axes at two arm configurations.
+  double BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
 
   TrimParameters parameters_;
   arm::ArmKinematics kinematics_;
   Eigen::Isometry3d T_cutter_blade_;
+  double blade_radius_ = 0.0, housing_radius_ = 0.0;  // m: the disc's, the cutter housing's (its link's cylinder)
   std::unique_ptr<robot::CollisionModel> collision_;
   std::unique_ptr<arm::ArmPlanner> planner_;
   std::optional<CuttingPathDatabase> database_;
