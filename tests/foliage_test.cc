@@ -214,21 +214,26 @@ TEST(Foliage, TheShareLeavesOutTheGroundAndIsGivenOverTheUpperHalf) {
   EXPECT_LT(cut.surface_within_tolerance, cut.upper_surface_within_tolerance - 0.3);
 }
 
+// The blade (0.05 m radius) pushed in along -out from 0.2 m outside to `at` (map frame). Its housing
+// is the last link's 0.03 m cylinder, 1 cm behind the disc, 0.13 m long.
+void PlungeBlade(Foliage* foliage, const Eigen::Vector3d& at, const Eigen::Vector3d& out) {
+  BladeDisc from, to;
+  from.centre = at + 0.2 * out;
+  to.centre = at;
+  from.axis = to.axis = out;
+  from.radius = to.radius = 0.05;
+  foliage->Cut(from, to);
+}
+
 TEST(Foliage, AHousingBehindABladeThatCutItsWayInIsClearOfTheLeavesBesideItIsNot) {
   const GardenObject bush = Topiary(Shape::kEllipsoid, {0.7, 0.7, 0.7});
   Foliage foliage = Foliage::Grown(bush, 4, 0.5);
-  // The blade (0.05 m radius) pushed in along -x from outside to the target's surface on the +x
-  // side, then its housing (the last link's 0.03 m cylinder, 1 cm behind the disc, 0.13 m long).
+  // The blade pushed in along -x to the target's surface on the +x side.
   const Eigen::Vector3d out = foliage.pose().linear() * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d surface = foliage.pose() * Eigen::Vector3d(0.35, 0.0, 0.0);
-  BladeDisc from, to;
-  from.centre = surface + 0.2 * out;
-  to.centre = surface;
-  from.axis = to.axis = out;
-  from.radius = to.radius = 0.05;
   const Eigen::Vector3d a = surface + 0.01 * out, b = a + 0.13 * out;
   EXPECT_TRUE(foliage.ReachesCylinder(a, b, 0.03)) << "the leaves stand there before the cut";
-  foliage.Cut(from, to);
+  PlungeBlade(&foliage, surface, out);
   EXPECT_FALSE(foliage.ReachesCylinder(a, b, 0.03));
   // The same housing 0.1 m to the side, beyond the blade's swept disc: in uncut leaves.
   const Eigen::Vector3d side = foliage.pose().linear() * Eigen::Vector3d(0.0, 0.1, 0.0);
@@ -259,14 +264,9 @@ TEST(Foliage, AHousingBehindABladePlungedNearABoxCornerIsClearOfTheLeaves) {
     const Eigen::Vector3d surface = cut.target().Radius(on_face.normalized()) * on_face.normalized();
     const Eigen::Vector3d n = cut.target().Normal(surface);
     const Eigen::Vector3d out = cut.pose().linear() * n, at = cut.pose() * surface;
-    BladeDisc from, to;
-    from.centre = at + 0.2 * out;
-    to.centre = at;
-    from.axis = to.axis = out;
-    from.radius = to.radius = 0.05;
     const Eigen::Vector3d a = at + 0.01 * out, b = a + 0.13 * out;
     EXPECT_TRUE(cut.ReachesCylinder(a, b, 0.03)) << "the leaves stand there before the cut";
-    cut.Cut(from, to);
+    PlungeBlade(&cut, at, out);
     EXPECT_FALSE(cut.ReachesCylinder(a, b, 0.03)) << "housing behind the blade at " << on_face.transpose();
     EXPECT_TRUE(cut.ReachesCylinder(a, b, 0.06)) << "leaves just beyond the blade's 5 cm stand";
   }
