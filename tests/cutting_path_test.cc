@@ -317,8 +317,6 @@ std::vector<Eigen::Vector3d> LeavesSeenFrom(const garden::Foliage& foliage, cons
   return leaves;
 }
 
-// The blade (the URDF's 5 cm disc) swept through the foliage along the path's straight moves,
-// 0.01 rad at a time; the planned moves are taken with the blade clear.
 // The blade's disc (the URDF's 5 cm) with the arm at `q`, the base at T_map_base.
 garden::BladeDisc BladeDiscAt(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
                               const Eigen::Isometry3d& T_map_base, const Eigen::VectorXd& q) {
@@ -330,6 +328,8 @@ garden::BladeDisc BladeDiscAt(const arm::ArmKinematics& kinematics, const Eigen:
   return disc;
 }
 
+// The blade swept through the foliage along the path's straight moves, 0.01 rad at a time; the
+// planned moves are taken with the blade clear.
 void SweepBlade(const Fixture& f, const CuttingPath& path, const Eigen::Isometry3d& T_map_base,
                 garden::Foliage* foliage) {
   const auto blade_at = [&](const Eigen::VectorXd& q) {

@@ -182,6 +182,7 @@ void Foliage::CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& 
   const Eigen::Vector3d ab = b - a;
   const double t = ab.squaredNorm() > 0.0 ? std::clamp(-a.dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
   if ((a + t * ab).norm() > reach_ + radius) return;
+  const long cut_before = cut_columns_;
   for (std::size_t i = 0; i < height_.size(); ++i) {
     // Along the column's line from its base, where the crossing is measured.
     const double depth = root_[i].dot(normal_[i]), length = depth + height_[i];
@@ -192,6 +193,7 @@ void Foliage::CutTranslated(const Eigen::Vector3d& from, const Eigen::Vector3d& 
       ++cut_columns_;
     }
   }
+  if (cut_columns_ == cut_before) return;  // every physics step while the cutter spins: mostly in the air
   reach_ = 0.0;
   for (int i = 0; i < columns(); ++i) reach_ = std::max(reach_, tip(i).norm());
 }
@@ -249,20 +251,25 @@ int Foliage::ColumnOf(const Eigen::Vector3d& p) const {
   return i;
 }
 
-bool Foliage::Reaches(const Eigen::Vector3d& point) const {
-  const Eigen::Vector3d p = T_map_centre_.inverse() * point;
+double Foliage::BeyondTip(const Eigen::Vector3d& p, int column) const {
+  const auto i = static_cast<std::size_t>(column);
+  return (p - root_[i]).dot(normal_[i]) - height_[i];
+}
+
+bool Foliage::InFoliage(const Eigen::Vector3d& p) const {
   const double distance = p.norm();
   if (distance < 1e-9) return true;
   if (distance > reach_) return false;
-  const auto i = static_cast<std::size_t>(ColumnOf(p));
-  return (p - root_[i]).dot(normal_[i]) <= height_[i];
+  return BeyondTip(p, ColumnOf(p)) <= 0.0;
 }
+
+bool Foliage::Reaches(const Eigen::Vector3d& point) const { return InFoliage(T_map_centre_.inverse() * point); }
 
 Eigen::Vector3d Foliage::CutBack(const Eigen::Vector3d& p) const {
   if (p.squaredNorm() < 1e-18) return p;
-  const auto i = static_cast<std::size_t>(ColumnOf(p));
-  const double excess = (p - root_[i]).dot(normal_[i]) - height_[i];
-  return excess > 0.0 ? Eigen::Vector3d(p - excess * normal_[i]) : p;
+  const int i = ColumnOf(p);
+  const double excess = BeyondTip(p, i);
+  return excess > 0.0 ? Eigen::Vector3d(p - excess * normal(i)) : p;
 }
 
 double Foliage::ExitRadius(const Eigen::Vector3d& d) const {
@@ -270,7 +277,7 @@ double Foliage::ExitRadius(const Eigen::Vector3d& d) const {
   double in = 0.0, out = reach_ + 0.01;
   for (int k = 0; k < 24; ++k) {  // 1 m / 2^24: well under a micrometre
     const double s = 0.5 * (in + out);
-    (Reaches(T_map_centre_ * (s * d)) ? in : out) = s;
+    (InFoliage(s * d) ? in : out) = s;
   }
   return in;
 }
@@ -280,20 +287,25 @@ bool Foliage::ReachesCylinder(const Eigen::Vector3d& a, const Eigen::Vector3d& b
   const Eigen::Vector3d axis = b - a;
   const double length = axis.norm();
   const Eigen::Vector3d z = length > 1e-9 ? Eigen::Vector3d(axis / length) : Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d x = z.unitOrthogonal(), y = z.cross(x);
+  // The samples' pattern is laid out in the map frame, then taken to the centre frame once.
+  const Eigen::Isometry3d T_centre_map = T_map_centre_.inverse();
+  const Eigen::Matrix3d& R = T_centre_map.linear();
+  const Eigen::Vector3d across_map = z.unitOrthogonal();
+  const Eigen::Vector3d x = R * across_map, y = R * z.cross(across_map);
+  const Eigen::Vector3d start = T_centre_map * a, step = R * axis;
   const int along = std::max(1, static_cast<int>(std::ceil(length / kStep)));
   const int round = std::max(6, static_cast<int>(std::ceil(2.0 * M_PI * radius / kStep)));
   const int across = std::max(1, static_cast<int>(std::ceil(radius / kStep)));
   for (int i = 0; i <= along; ++i) {
-    const Eigen::Vector3d c = a + axis * (static_cast<double>(i) / along);
-    if (Reaches(c)) return true;
+    const Eigen::Vector3d c = start + step * (static_cast<double>(i) / along);
+    if (InFoliage(c)) return true;
     // The mantle at every step; the caps' discs at the two ends.
     const int rings = i == 0 || i == along ? across : 1;
     for (int ring = 1; ring <= rings; ++ring) {
       const double r = radius * (rings == 1 ? 1.0 : static_cast<double>(ring) / rings);
       for (int k = 0; k < round; ++k) {
         const double angle = 2.0 * M_PI * k / round;
-        if (Reaches(c + r * (std::cos(angle) * x + std::sin(angle) * y))) return true;
+        if (InFoliage(c + r * (std::cos(angle) * x + std::sin(angle) * y))) return true;
       }
     }
   }

@@ -276,7 +276,7 @@ std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, s
     if (!in.empty()) first = k;
   }
   for (std::size_t k = last; k >= first && k + kMaxLeftOut >= last && out.empty(); --k) {
-    out = way_round(k);
+    out = k == first && !in.empty() ? in : way_round(k);  // the way in, when it is the one pose left
     if (!out.empty()) final = k;
     if (k == first) break;
   }

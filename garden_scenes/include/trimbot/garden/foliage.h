@@ -139,6 +139,10 @@ class Foliage {
   int CellOf(const Eigen::Vector3d& p) const;
   // The column whose line passes nearest p (centre frame; through it but for the grid).
   int ColumnOf(const Eigen::Vector3d& p) const;
+  // How far p (centre frame) lies beyond the tip along `column`'s normal (<= 0: in its leaves).
+  double BeyondTip(const Eigen::Vector3d& p, int column) const;
+  // Reaches, for a point in the centre frame.
+  bool InFoliage(const Eigen::Vector3d& p) const;
   // Where the foliage ends along a ray from the centre (unit `direction`, centre frame).
   double ExitRadius(const Eigen::Vector3d& direction) const;
   // |cos| of the angle between column i's direction from the centre and its normal (at least 0.1).
