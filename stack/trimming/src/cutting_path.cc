@@ -8,10 +8,7 @@
 #include <utility>
 
 namespace trimbot::trimming {
-namespace {
 
-// Outward unit normal of the target at a point near its surface: the gradient of the radial
-// distance, by central differences (the superellipsoid's own gradient, up to its length).
 Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eigen::Vector3d& p) {
   constexpr double h = 1e-5;
   Eigen::Vector3d g;
@@ -21,6 +18,8 @@ Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eige
   }
   return g.normalized();
 }
+
+namespace {
 
 // A rotation whose z axis is `z` (unit) and whose x axis is `x_hint` made perpendicular to it.
 Eigen::Matrix3d FrameWithZ(const Eigen::Vector3d& z, const Eigen::Vector3d& x_hint) {

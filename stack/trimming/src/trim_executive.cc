@@ -304,11 +304,15 @@ std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, s
   first_blade_waypoint_ = waypoints.size() - 1;
   for (std::size_t i = first; i < final; ++i) {
     const Eigen::VectorXd to = waypoints.back() + kinematics_.JointDifference(waypoints.back(), q[i + 1]);
-    // A straight move that keeps the blade's turn small stays in the swath it cuts; any other goes
-    // out along the axis, round the leaves and in (where it can), not through them.
+    // A straight move that keeps the blade's turn and its tilt off the surface small stays in the
+    // swath it cuts; any other goes out along the axis, round the leaves and in (where it can), not
+    // through them.
     const bool straight = !path.planned[i];
     std::vector<Eigen::VectorXd> way;
-    if (!straight || BladeTurn(waypoints.back(), to) > MaxTurnInLeaves()) way = RoundTheLeaves(waypoints.back(), to);
+    if (!straight || BladeTurn(waypoints.back(), to) > MaxTurnInLeaves() ||
+        MaxTiltAlong(waypoints.back(), to) > MaxTurnInLeaves()) {
+      way = RoundTheLeaves(waypoints.back(), to);
+    }
     if (!way.empty()) {
       append(way);
       ++report_.turns_round_the_leaves;
@@ -369,6 +373,20 @@ std::vector<Eigen::VectorXd> TrimExecutive::RoundTheLeaves(const Eigen::VectorXd
 double TrimExecutive::MaxTurnInLeaves() const {
   const double height = parameters_.blade_depth + report_.leaf_depth;
   return height > blade_radius_ - housing_radius_ ? std::asin((blade_radius_ - housing_radius_) / height) : M_PI;
+}
+
+double TrimExecutive::MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
+  const Eigen::VectorXd d = to - from;  // unwrapped: the move the trajectory makes
+  const int steps =
+      std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / parameters_.planner.collision_step)));
+  double tilt = 0.0;
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Isometry3d blade =
+        kinematics_.EndEffectorPose(from + d * (static_cast<double>(k) / steps)) * T_cutter_blade_;
+    const Eigen::Vector3d inward = -SurfaceNormal(target_shape_, blade.translation());
+    tilt = std::max(tilt, std::acos(std::clamp(inward.dot(blade.linear().col(2)), -1.0, 1.0)));
+  }
+  return tilt;
 }
 
 double TrimExecutive::BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {

@@ -28,6 +28,10 @@ struct CuttingPoseOptions {
   double min_height = 0.05;       // m above the ground for the blade's centre
 };
 
+// Outward unit normal of the target at a point near its surface: the gradient of the radial
+// distance, by central differences (the superellipsoid's own gradient, up to its length).
+Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eigen::Vector3d& p);
+
 // The blade pose on the target's surface along a unit direction from its centre (both in the
 // target's frame, base_link): the disc's centre on the surface, its z axis into it along the inward
 // normal, its x axis `x_hint` made tangent (or any tangent when `x_hint` is zero or normal).

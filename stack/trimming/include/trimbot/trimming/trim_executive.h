@@ -81,8 +81,9 @@ struct TrimReport {
                                         // blade's axis (the others round the shrunk target only: no such way found)
   int left_out = 0;                     // blade poses at the path's ends left out: no way in or out round the leaves
   int turns_round_the_leaves = 0;       // moves between blade poses out along the axis, round the leaves and in:
-                                        // those that turn the blade too far to stay in the swath it cuts
-                                        // (MaxTurnInLeaves) and those a straight move was refused
+                                        // those that turn the blade too far to stay in the swath it cuts or
+                                        // tilt it too far off the surface on the way (MaxTurnInLeaves), and
+                                        // those a straight move was refused
 };
 
 class TrimExecutive {
@@ -153,7 +154,14 @@ class TrimExecutive {
   // cuts: turning by a about the disc's centre moves the housing's mantle sideways by h sin(a) at
   // height h over the disc, and the leaves stand up to blade_depth + leaf_depth over it; the
   // housing (r_h) stays within the disc (r_b) while that is at most r_b - r_h.
+  // The same bounds the blade's tilt off the leaves: they grow along the surface's normal, and one
+  // leaning by more than this off the axis passes from beside the swath into the housing.
   double MaxTurnInLeaves() const;
+  // The largest angle between the blade's axis and the fitted surface's normal at the blade's
+  // centre along the straight joint move from `from` to `to` (sampled as the collision checks
+  // are): a move between two blade poses, each tangent to the surface, can tilt the blade far off
+  // it on the way (the wrist's joints interpolated), though the two poses' axes are close.
+  double MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
   // The angle between the blade's axes at two arm configurations.
   double BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
 
