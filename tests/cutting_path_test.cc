@@ -567,7 +567,9 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
 // surface's normal, lean at most MaxTurnInLeaves off the blade's axis; a straight joint move
 // between two blade poses near the box's top corner tilted the blade 34-44 deg off the surface
 // on the way (4 housing touches with the stack's own pose spacing and rolls, none since such
-// moves go round the leaves; docs/design.md).
+// moves go round the leaves), and the upper arm reached into the leaves over the box's near edge
+// once (none since the links but the cutter's are kept out of the leaves the scan saw;
+// docs/design.md).
 TEST(TrimExecutive, TrimsABoxFromItsCorner) {
   const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
   garden::GardenObject box;

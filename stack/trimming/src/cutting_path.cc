@@ -127,10 +127,13 @@ void SetTargetEnvironment(robot::CollisionModel* collision, const perception::To
 }
 
 CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
-                                const perception::TopiaryShape& target, double tolerance, double step) {
+                                const perception::TopiaryShape& target, double tolerance, double step,
+                                const std::function<bool(const Eigen::VectorXd&)>& also_valid) {
   SetTargetEnvironment(collision, target, -tolerance);
   CuttingChecks checks;
-  checks.valid = [collision](const Eigen::VectorXd& q) { return !collision->Check(q).collision; };
+  checks.valid = [collision, also_valid](const Eigen::VectorXd& q) {
+    return !collision->Check(q).collision && (!also_valid || also_valid(q));
+  };
   checks.free_move = [&kinematics, valid = checks.valid, step](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     const Eigen::VectorXd d = kinematics.JointDifference(a, b);
     const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / step)));

@@ -62,6 +62,12 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
   parameters_.path.velocity_scale = parameters.planner.velocity_scale;
   parameters_.path.acceleration = parameters.planner.acceleration;
   parameters_.path.ik = parameters.planner.ik;
+  const std::vector<robot::LinkCylinder> cylinders = description.ArmLinkCylinders();
+  const std::vector<std::string>& links = kinematics_.links();
+  for (std::size_t c = 0; c + 1 < cylinders.size(); ++c) {  // the last, link 6, carries the cutter
+    const auto at = std::find(links.begin(), links.end(), cylinders[c].link);
+    if (at != links.end()) arm_links_.emplace_back(static_cast<std::size_t>(at - links.begin()), cylinders[c]);
+  }
 }
 
 TrimExecutive::~TrimExecutive() = default;
@@ -192,7 +198,8 @@ void TrimExecutive::Plan(double stamp) {
   const perception::TopiaryShape& target = target_shape_;
   std::string failure;
   const CuttingChecks checks = MakeCuttingChecks(kinematics_, collision_.get(), target, parameters_.tolerance,
-                                                 parameters_.planner.collision_step);
+                                                 parameters_.planner.collision_step,
+                                                 [this](const Eigen::VectorXd& q) { return !ArmInLeaves(q); });
   planner_->ResetRoadmap();
   // Where the blade goes: the fitted surface, or blade_depth inside it.
   perception::TopiaryShape blade_surface = target;
@@ -373,6 +380,19 @@ std::vector<Eigen::VectorXd> TrimExecutive::RoundTheLeaves(const Eigen::VectorXd
 double TrimExecutive::MaxTurnInLeaves() const {
   const double height = parameters_.blade_depth + report_.leaf_depth;
   return height > blade_radius_ - housing_radius_ ? std::asin((blade_radius_ - housing_radius_) / height) : M_PI;
+}
+
+bool TrimExecutive::ArmInLeaves(const Eigen::VectorXd& q) const {
+  const std::vector<Eigen::Isometry3d> poses = kinematics_.LinkPoses(q);
+  for (const auto& [index, cylinder] : arm_links_) {
+    const Eigen::Vector3d a = poses[index] * cylinder.a, b = poses[index] * cylinder.b;
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.01)));
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(k) / steps);
+      if (target_shape_.RadialDistance(p) < report_.leaf_depth + cylinder.radius) return true;
+    }
+  }
+  return false;
 }
 
 double TrimExecutive::MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {

@@ -79,14 +79,17 @@ void SetTargetEnvironment(robot::CollisionModel* collision, const perception::To
 
 // The collision checks of a cutting path on the arm's collision model, whose environment becomes
 // the ground and the target shrunk by `tolerance` as a solid (convex) polyhedron: the blade may go
-// that deep, and the surface it leaves stays within tolerance of the target. A move is free when
-// its configurations `step` apart (rad, continuous joints the short way round) are.
+// that deep, and the surface it leaves stays within tolerance of the target. `also_valid`, when
+// given, is a further condition on each configuration (the executive's: no arm link but the
+// cutter's in the leaves the scan saw). A move is free when its configurations `step` apart (rad,
+// continuous joints the short way round) are.
 struct CuttingChecks {
   std::function<bool(const Eigen::VectorXd&)> valid;
   std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)> free_move;
 };
 CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
-                                const perception::TopiaryShape& target, double tolerance = 0.02, double step = 0.02);
+                                const perception::TopiaryShape& target, double tolerance = 0.02, double step = 0.02,
+                                const std::function<bool(const Eigen::VectorXd&)>& also_valid = {});
 
 // `valid(q)`: the configuration is free; `free_move(a, b)`: the straight joint move is free.
 // `T_cutter_blade`: the blade's disc in the cutter frame (from the URDF).

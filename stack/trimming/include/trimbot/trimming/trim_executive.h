@@ -20,13 +20,15 @@
 // The collision model's environment is the ground and the fitted target shrunk by the cut's
 // tolerance (MakeCuttingChecks): the leaves outside it are what the blade is there to cut. For
 // the moves in and out it is the target grown by the leaves' depth the scan measured, so no link
-// but the blade goes into them. Nothing here sees ground truth.
+// but the blade goes into them. While cutting, the links but the cutter's keep out of those
+// leaves too (ArmInLeaves). Nothing here sees ground truth.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "trimbot/arm/arm_planner.h"
@@ -162,6 +164,12 @@ class TrimExecutive {
   // are): a move between two blade poses, each tangent to the surface, can tilt the blade far off
   // it on the way (the wrist's joints interpolated), though the two poses' axes are close.
   double MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+  // Whether an arm link other than the cutter's reaches into the leaves as the scan saw them (the
+  // fitted target grown by leaf_depth): points 1 cm apart on each link's collision cylinder's axis,
+  // within the cylinder's radius of that surface along the ray from the target's centre. The
+  // cutter's link trails the blade in the swath it cuts (MaxTurnInLeaves); the others - the upper
+  // arm reaching over a bush's near edge - would push through leaves no blade has cut.
+  bool ArmInLeaves(const Eigen::VectorXd& q) const;
   // The angle between the blade's axes at two arm configurations.
   double BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
 
@@ -169,6 +177,9 @@ class TrimExecutive {
   arm::ArmKinematics kinematics_;
   Eigen::Isometry3d T_cutter_blade_;
   double blade_radius_ = 0.0, housing_radius_ = 0.0;  // m: the disc's, the cutter housing's (its link's cylinder)
+  // The collision cylinders of the arm's links but the cutter's, each with its link's index in
+  // kinematics_.links().
+  std::vector<std::pair<std::size_t, robot::LinkCylinder>> arm_links_;
   std::unique_ptr<robot::CollisionModel> collision_;
   std::unique_ptr<arm::ArmPlanner> planner_;
   std::optional<CuttingPathDatabase> database_;
