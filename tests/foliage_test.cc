@@ -39,7 +39,7 @@ double BruteForceCut(const Foliage& foliage, int i, const BladeDisc& from, const
     const double along = std::clamp((q - from.centre).dot(way) / way.squaredNorm(), 0.0, 1.0);
     if ((q - from.centre - along * way).norm() > from.radius + 0.001) continue;
     for (int k = 0; k <= 1000; ++k) {
-      const Eigen::Vector3d c = from.centre + (to.centre - from.centre) * (k / 1000.0);
+      const Eigen::Vector3d c = from.centre + way * (k / 1000.0);
       const Eigen::Vector3d v = q - c;
       if (std::abs(v.dot(axis)) <= 0.0005 && (v - v.dot(axis) * axis).norm() <= from.radius) return s - depth;
     }
