@@ -10,14 +10,13 @@
 #include <set>
 #include <sstream>
 
+#include "trimbot/common/angles.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/random.h"
 #include "trimbot/common/yaml_reader.h"
 
 namespace trimbot::garden {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 Shape ParseShape(const YamlMap& map) {
   const std::string shape = map.String("shape");

@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 
+#include "trimbot/common/angles.h"
 #include "trimbot/common/atomic_file.h"
 #include "trimbot/common/input_error.h"
 #include "trimbot/common/parse_number.h"
@@ -20,8 +21,6 @@
 
 namespace trimbot::garden {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // GardenUI's label families; anything else is refused rather than guessed.
 std::optional<ObjectClass> ClassOfLabel(const std::string& label) {

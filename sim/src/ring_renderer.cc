@@ -10,6 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "trimbot/common/wall_clock.h"
+
 namespace trimbot::sim {
 
 struct RingRenderer::GlState {
@@ -25,8 +27,6 @@ struct RingRenderer::GlState {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 using Vec3 = Eigen::Vector3d;
 

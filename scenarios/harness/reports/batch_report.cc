@@ -267,7 +267,7 @@ Histogram BinCentimetres(const std::vector<double>& samples_m) {
 
 void DrawHistogramPanel(cv::Mat& image, cv::Rect panel, const std::string& name, std::vector<double> samples_m) {
   const cv::Scalar kBar(86, 135, 190), kBarEdge(40, 75, 120), kMean(200, 40, 40), kMedian(230, 140, 20),
-      kAxis(60, 60, 60), kGridLine(232, 232, 232);
+      kGridLine(232, 232, 232);
   samples_m.erase(std::remove_if(samples_m.begin(), samples_m.end(), [](double s) { return !std::isfinite(s); }),
                   samples_m.end());
   const ErrorStats stats = ErrorStats::From(samples_m);

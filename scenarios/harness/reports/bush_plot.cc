@@ -13,8 +13,7 @@ namespace {
 constexpr double kReferenceDistanceCm = 1.26;  // D3.4 Figure 20: mean over 5 trials
 constexpr double kReferenceBearingDeg = 2.08;
 
-const cv::Scalar kAxis(60, 60, 60), kTruth(120, 120, 120), kEstimate(40, 110, 200), kReached(220, 120, 40),
-    kReference(200, 40, 40);
+const cv::Scalar kTruth(120, 120, 120), kEstimate(40, 110, 200), kReached(220, 120, 40), kReference(200, 40, 40);
 
 }  // namespace
 

@@ -84,7 +84,7 @@ double NiceStep(double range, int ticks) {
 }
 
 namespace {
-const cv::Scalar kAxis(60, 60, 60), kGrid(225, 225, 225);
+const cv::Scalar kGrid(225, 225, 225);
 }  // namespace
 
 Panel::Panel(cv::Mat& image, cv::Rect area, double x0, double x1, double y0, double y1, const std::string& label)

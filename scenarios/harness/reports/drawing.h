@@ -12,7 +12,8 @@ namespace trimbot::scenarios {
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 const cv::Scalar kInk(30, 30, 30);
 const cv::Scalar kWhite(255, 255, 255);
-constexpr int kSubpixelBits = 4;  // cv drawing functions take fixed-point points with this shift
+const cv::Scalar kAxis(60, 60, 60);  // plots' axes, frames and tick labels
+constexpr int kSubpixelBits = 4;     // cv drawing functions take fixed-point points with this shift
 
 // Short, exact enough for people: 1, 0.95, 0.666667.
 std::string FormatNumber(double value);

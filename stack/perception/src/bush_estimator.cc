@@ -18,8 +18,8 @@ struct BushPoint {
 // Signed distance (m) from a point to the shape scaled by s and centred at c. Ellipsoid and
 // cylinder: approximate, the implicit function u (1 on the surface) over its gradient's length
 // (Sampson); box: exact.
-struct SurfaceResidual {
-  SurfaceResidual(const BushPoint& point, const BushShape& shape) : point(point), shape(shape) {}
+struct BushSurfaceResidual {
+  BushSurfaceResidual(const BushPoint& point, const BushShape& shape) : point(point), shape(shape) {}
 
   template <typename T>
   bool operator()(const T* centre, const T* scale, T* residual) const {
@@ -71,7 +71,7 @@ struct ScalePrior {
 
 double Residual(const BushPoint& point, const BushShape& shape, const Eigen::Vector2d& centre, double scale) {
   double r = 0.0;
-  SurfaceResidual(point, shape)(centre.data(), &scale, &r);
+  BushSurfaceResidual(point, shape)(centre.data(), &scale, &r);
   return r;
 }
 
@@ -81,7 +81,7 @@ bool Solve(const std::vector<BushPoint>& points, const BushShape& shape, const B
   ceres::Problem problem;
   for (const BushPoint& point : points) {
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<SurfaceResidual, 1, 2, 1>(new SurfaceResidual(point, shape)),
+        new ceres::AutoDiffCostFunction<BushSurfaceResidual, 1, 2, 1>(new BushSurfaceResidual(point, shape)),
         new ceres::HuberLoss(options.huber), centre->data(), scale);
   }
   if (fit_scale) {

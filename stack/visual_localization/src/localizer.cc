@@ -12,11 +12,12 @@
 #include <set>
 #include <stdexcept>
 
+#include "trimbot/common/wall_clock.h"
+
 namespace trimbot::visual_localization {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The two nearest visual words of each descriptor: brute force over the vocabulary (a few hundred
 // words: exact and fast enough), blocks of rows in parallel, each into its own slots - the same
@@ -235,11 +236,11 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   auto start = Clock::now();
   FrameFeatures features = Extract(frame);
   result.features = features.descriptors.rows;
-  result.timings.features = Since(start);
+  result.timings.features = SecondsSince(start);
   start = Clock::now();
   AssignWords(&features);
   result.retrieved = Retrieve(features, prior_position, options_.retrieval, options_.keyframes);
-  result.timings.retrieval = Since(start);
+  result.timings.retrieval = SecondsSince(start);
   if (features.descriptors.rows < options_.pose.min_inliers || result.retrieved.empty()) {
     const bool few_features = features.descriptors.rows < options_.pose.min_inliers;
     result.failure = few_features ? "too few features" : "no keyframe retrieved";
@@ -249,10 +250,10 @@ LocalizationResult VisualLocalizer::Localize(const messages::RingFrame& frame,
   start = Clock::now();
   const std::vector<Correspondence> correspondences = Match(features, result.retrieved);
   result.matches = static_cast<int>(correspondences.size());
-  result.timings.matching = Since(start);
+  result.timings.matching = SecondsSince(start);
   start = Clock::now();
   const RigPoseResult pose = EstimateRigPose(correspondences, T_base_camera_, options_.pose);
-  result.timings.pose = Since(start);
+  result.timings.pose = SecondsSince(start);
   if (!pose.success) {
     result.failure = pose.failure;
     result.failed_stage =

@@ -13,6 +13,7 @@
 
 #include "map_adjustment.h"
 #include "trimbot/common/rotation.h"
+#include "trimbot/common/wall_clock.h"
 #include "trimbot/visual_localization/localizer.h"
 
 namespace trimbot::visual_localization {
@@ -28,7 +29,6 @@ using mapping::Track;
 using mapping::WheelScales;
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 double RotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
@@ -426,7 +426,7 @@ bool MapBuilder::AddFrame(const messages::RingFrame& frame, const Eigen::Isometr
           ExtractImageFeatures(image, rig_.camera(image.camera_index).intrinsics, options_.features);
     }
   }
-  stats_.seconds_features += Since(start);
+  stats_.seconds_features += SecondsSince(start);
   AddKeyframe(frame.stamp, std::move(images), T_map_base);
   return true;
 }
@@ -443,18 +443,18 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
       keyframes_, rig_, odometry ? options_.odometry_epipolar_angle : options_.epipolar_angle, options_, &stats_);
   std::vector<PointTrack> points =
       TriangulateTracks(keyframes_, rig_, matches, options_, 4.0 * options_.epipolar_angle, &stats_);
-  stats_.seconds_matching = Since(start);
+  stats_.seconds_matching = SecondsSince(start);
   start = Clock::now();
   WheelScales scales = MakeWheelScales(keyframes_, options_.odometry);
   if (!odometry) {
     AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
-    stats_.seconds_adjustment = Since(start);
+    stats_.seconds_adjustment = SecondsSince(start);
   } else {
     // A provisional map (one adjustment, outliers dropped) for retrieval and the loops' poses.
     std::vector<double> errors;
     Adjust(rig_, options_, keyframes_, points, scales, &errors);
     RemoveOutliers(errors, options_.max_reprojection_error, points);
-    stats_.seconds_adjustment = Since(start);
+    stats_.seconds_adjustment = SecondsSince(start);
     // Close the loops on it, then match again where the corrected poses allow.
     start = Clock::now();
     loops_ = FindLoops(MakeMap(garden, rig_, options_, keyframes_, points), rig_, options_, keyframes_, &stats_);
@@ -482,11 +482,11 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
       }
     }
     matches = std::move(kept);
-    stats_.seconds_loops = Since(start);
+    stats_.seconds_loops = SecondsSince(start);
     start = Clock::now();
     points = TriangulateTracks(keyframes_, rig_, matches, options_, 4.0 * options_.epipolar_angle, &stats_);
     AdjustTwice(rig_, options_, keyframes_, points, scales, &stats_);
-    stats_.seconds_adjustment += Since(start);
+    stats_.seconds_adjustment += SecondsSince(start);
     stats_.scale_stretches = static_cast<int>(scales.scale.size());
     stats_.scale_min = *std::min_element(scales.scale.begin(), scales.scale.end());
     stats_.scale_max = *std::max_element(scales.scale.begin(), scales.scale.end());
@@ -503,7 +503,7 @@ VisualMap MapBuilder::Build(const std::string& garden, MapBuildStats* stats) {
   stats_.gaps = FindGaps(keyframes_.size(), points, options_.min_shared_points);
   start = Clock::now();
   VisualMap map = MakeMap(garden, rig_, options_, keyframes_, points);
-  stats_.seconds_vocabulary = Since(start);
+  stats_.seconds_vocabulary = SecondsSince(start);
   stats_.keyframes = static_cast<int>(map.keyframes.size());
   stats_.points = static_cast<int>(map.points.size());
   stats_.observations = static_cast<int>(map.observations.size());
