@@ -11,6 +11,7 @@
 #include <regex>
 #include <sstream>
 
+#include "evaluation/contact_events.h"
 #include "loop/prior_knowledge.h"
 #include "loop/scenario.h"
 #include "loop/simulated_pose_fixes.h"
@@ -56,6 +57,20 @@ void ExpectLoadError(const std::string& path, const std::string& file, const std
     EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << e.what();
   }
+}
+
+// An arm contact counts once while the pair touches (MuJoCo reports a pair once per contact point),
+// again when it touches anew, and names the two geoms.
+TEST(ContactEvents, APairCountsOnceWhileItTouchesAndIsNamed) {
+  ContactEvents events;
+  const sim::ArmContact wood{"arm_link_6", "bush_2_wood", 0.001}, ground{"arm_link_3", "ground", 0.002};
+  const auto first = events.Update({wood, wood, ground});  // two contact points of the first pair
+  ASSERT_EQ(first.size(), 2u);
+  EXPECT_EQ(first[0], std::make_pair(std::string("arm_link_3"), std::string("ground")));
+  EXPECT_EQ(first[1], std::make_pair(std::string("arm_link_6"), std::string("bush_2_wood")));
+  EXPECT_TRUE(events.Update({wood}).empty()) << "still touching";
+  EXPECT_TRUE(events.Update({}).empty());
+  EXPECT_EQ(events.Update({wood}).size(), 1u) << "touching anew";
 }
 
 TEST(Scenario, TheRealRobotsTrialSetsLoad) {

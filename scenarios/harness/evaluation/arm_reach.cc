@@ -138,7 +138,7 @@ ArmReachEvaluator::ArmReachEvaluator(const ArmReach& spec, std::vector<ArmReachP
 void ArmReachEvaluator::Observe(const StepView& step) {
   const sim::GroundTruth& truth = step.truth;
   const bool working = current_ < static_cast<int>(outcomes_.size());
-  const int events = contact_events_.Update(truth.arm_contacts);
+  const int events = static_cast<int>(contact_events_.Update(truth.arm_contacts).size());
   contacts_ += events;
   if (working) outcomes_[static_cast<size_t>(current_)].contacts += events;
 

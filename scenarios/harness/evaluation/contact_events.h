@@ -12,12 +12,15 @@ namespace trimbot::scenarios {
 
 class ContactEvents {
  public:
-  // This step's arm contacts in; the events among them (pairs new since the last step) out.
-  int Update(const std::vector<sim::ArmContact>& contacts) {
+  // This step's arm contacts in; the events among them (pairs new since the last step, as arm
+  // geom and other geom) out.
+  std::vector<std::pair<std::string, std::string>> Update(const std::vector<sim::ArmContact>& contacts) {
     std::set<std::pair<std::string, std::string>> touching;
     for (const sim::ArmContact& contact : contacts) touching.insert({contact.arm_geom, contact.other_geom});
-    int events = 0;
-    for (const auto& pair : touching) events += touching_.count(pair) ? 0 : 1;
+    std::vector<std::pair<std::string, std::string>> events;
+    for (const auto& pair : touching) {
+      if (!touching_.count(pair)) events.push_back(pair);
+    }
     touching_ = std::move(touching);
     return events;
   }

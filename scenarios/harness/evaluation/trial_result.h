@@ -109,7 +109,11 @@ struct TrimOutcome {
   double within_2cm_after = 0.0;
   double within_2cm_upper_before = 0.0;  // the same above the target's centre (the half the arm reaches)
   double within_2cm_upper_after = 0.0;
-  double overcut_share = 0.0;         // of the target's volume cut away
+  double overcut_share = 0.0;  // of the target's volume cut away
+  // The bush as this trim left it (the fields above: as the trial left it, after every trim of it),
+  // so each side's part can be told apart.
+  double within_2cm_at_trim_end = 0.0;
+  double overcut_share_at_trim_end = 0.0;
   double overgrowth_before_m3 = 0.0;  // foliage volume outside the target
   double overgrowth_after_m3 = 0.0;
   double cutting_seconds = 0.0;             // simulated, the blade spinning
@@ -131,15 +135,19 @@ struct TrimOutcome {
   int arm_contacts = 0;                     // contact events of the arm (MuJoCo: the wood, the ground, itself)
   int foliage_touches = 0;                  // events of an arm link other than the blade reaching into the foliage
   std::map<std::string, int> foliage_touches_by;  // the same by "<link> while <the trim's stage>"
+  std::map<std::string, int> arm_contacts_by;     // arm_contacts by "<arm geom> with <geom> while <stage>"
 };
 // Fields missing from a result written before they were added read as their defaults (a suite
 // resumed over older batches).
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
-    TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after, within_2cm_upper_before,
-    within_2cm_upper_after, overcut_share, overgrowth_before_m3, overgrowth_after_m3, cutting_seconds, trim_seconds,
-    points, poses, reached_poses, from_database, path_source, motion_seconds, nearest_neighbour_seconds,
-    fit_centre_error_m, fit_axes_error_max_m, fit_centre_offset_m, fit_half_m, leaf_depth_m, moves_round_the_leaves,
-    poses_left_out, turns_round_the_leaves, arm_contacts, foliage_touches, foliage_touches_by)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before,
+                                                within_2cm_after, within_2cm_upper_before, within_2cm_upper_after,
+                                                overcut_share, within_2cm_at_trim_end, overcut_share_at_trim_end,
+                                                overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
+                                                trim_seconds, points, poses, reached_poses, from_database, path_source,
+                                                motion_seconds, nearest_neighbour_seconds, fit_centre_error_m,
+                                                fit_axes_error_max_m, fit_centre_offset_m, fit_half_m, leaf_depth_m,
+                                                moves_round_the_leaves, poses_left_out, turns_round_the_leaves,
+                                                arm_contacts, foliage_touches, foliage_touches_by, arm_contacts_by)
 
 // A trim's wall-clock time beside its simulated time (issue 31: trimming one bush must not take
 // longer in wall time than in simulated time). Wall clock: timing.json only, never summary.json.

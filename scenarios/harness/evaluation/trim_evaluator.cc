@@ -78,7 +78,10 @@ void TrimEvaluator::Observe(const StepView& step) {
   if (telemetry->trim->mode == trimming::ToString(trimming::TrimExecutive::Mode::kCutting)) {
     trim->outcome.cutting_seconds += step.timestep;
   }
-  trim->outcome.arm_contacts += contact_events_.Update(step.truth.arm_contacts);
+  for (const auto& [arm, other] : contact_events_.Update(step.truth.arm_contacts)) {
+    ++trim->outcome.arm_contacts;
+    ++trim->outcome.arm_contacts_by[arm + " with " + other + " while " + telemetry->trim->stage];
+  }
   if (steps_ % kTouchEvery != 0) return;
   const std::string link = LinkInFoliage(step.truth, *simulator_.foliage(trim->outcome.bush));
   if (!link.empty() && !trim->touching) {
@@ -111,9 +114,12 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   if (trim->started >= 0.0) {
     trim->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trim->wall_started).count();
   }
+  const garden::Foliage& foliage = *simulator_.foliage(o.bush);
+  const garden::CutQuality quality = foliage.Measure(kTolerance);
+  o.within_2cm_at_trim_end = quality.surface_within_tolerance;
+  o.overcut_share_at_trim_end = quality.target_volume > 0.0 ? quality.overcut_volume / quality.target_volume : 0.0;
   if (!report.fit) return;
   // The fit in base_link, placed where the base truly stood, against the true target.
-  const garden::Foliage& foliage = *simulator_.foliage(o.bush);
   const Eigen::Vector3d centre = trim->T_map_base * report.fit->centre;
   const Eigen::Vector3d offset = centre - foliage.pose().translation();
   o.fit_centre_error_m = offset.norm();
