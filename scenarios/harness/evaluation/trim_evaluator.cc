@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "trimbot/common/wall_clock.h"
+
 namespace trimbot::scenarios {
 namespace {
 
@@ -112,7 +114,7 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.turns_round_the_leaves = report.turns_round_the_leaves;
   trim->planning_seconds = report.planning_seconds;
   if (trim->started >= 0.0) {
-    trim->wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trim->wall_started).count();
+    trim->wall_seconds = SecondsSince(trim->wall_started);
   }
   const garden::Foliage& foliage = *simulator_.foliage(o.bush);
   const garden::CutQuality quality = foliage.Measure(kTolerance);

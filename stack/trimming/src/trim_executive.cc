@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "trimbot/common/wall_clock.h"
+
 namespace trimbot::trimming {
 namespace {
 
@@ -188,7 +190,7 @@ void TrimExecutive::Fit(double stamp) {
   for (const Eigen::Vector3d& p : bush) outside.push_back(std::max(0.0, fit->shape.RadialDistance(p)));
   report_.leaf_depth = Quantile(outside, parameters_.leaf_quantile);
   report_.fit_loss = fit->loss;
-  report_.planning_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  report_.planning_seconds = SecondsSince(begin);
   mode_ = Mode::kFitted;
   if (!cut_) Finish(stamp, "");  // a scan only
 }
@@ -240,7 +242,7 @@ void TrimExecutive::Plan(double stamp) {
   report_.reached = static_cast<int>(path.poses.size());
   report_.motion_time = path.motion_time;
   const std::vector<Eigen::VectorXd> waypoints = Waypoints(path, &failure);
-  report_.planning_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  report_.planning_seconds += SecondsSince(begin);
   if (waypoints.empty()) {
     Finish(stamp, failure);
     return;
