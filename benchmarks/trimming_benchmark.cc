@@ -69,7 +69,9 @@ struct BallInFront {
     kinematics.PrepareDatabase();
   }
   trimming::CuttingPath PlanInFull() {
-    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(kinematics, &collision, target);
+    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(
+        kinematics, T_cutter_blade, &collision, target,
+        trimming::CheckDepth(target, 0.0, trimming::CuttingPoseOptions{}.spacing, robot.BladeThickness()));
     return trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target), checks.valid,
                                      checks.free_move);
   }
@@ -102,7 +104,9 @@ void BM_AdaptStoredPath(benchmark::State& state) {
     const double angle = 2.0 * M_PI * UniformUnit(rng), offset = 0.02 + 0.03 * UniformUnit(rng);
     moved.centre += offset * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
     moved.half = Eigen::Vector3d::Constant(0.27 + 0.06 * UniformUnit(rng));
-    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(ball.kinematics, &ball.collision, moved);
+    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(
+        ball.kinematics, ball.T_cutter_blade, &ball.collision, moved,
+        trimming::CheckDepth(moved, 0.0, trimming::CuttingPoseOptions{}.spacing, ball.robot.BladeThickness()));
     state.ResumeTiming();
     const trimming::CuttingPath adapted = trimming::AdaptCuttingPath(ball.kinematics, ball.T_cutter_blade, ball.home,
                                                                      stored, moved, checks.valid, checks.free_move);

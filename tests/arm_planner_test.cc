@@ -187,5 +187,21 @@ TEST(ArmPlanner, TimingStartsAndEndsAtRestWithinTheLimits) {
   EXPECT_NEAR(t.duration(), 2.5 + 0.7 / 0.3 + 0.3, 1e-9);
 }
 
+TEST(ArmPlanner, TimingPassesThroughWaypointsThatAreNoStops) {
+  // A line of 1 rad in four steps, stopping at its ends only, takes as long as the line in one:
+  // 2.5 s (above), and passes the middle at speed; stopping at every step takes longer.
+  std::vector<Eigen::VectorXd> line;
+  for (int k = 0; k <= 4; ++k) line.push_back((Eigen::VectorXd(2) << 0.25 * k, 0.0).finished());
+  const Eigen::VectorXd limits = (Eigen::VectorXd(2) << 0.5, 0.3).finished();
+  const JointTrajectory through = TimeParameterize(line, limits, 1.0, {true, false, false, false, true});
+  EXPECT_NEAR(through.duration(), 2.5, 1e-9);
+  Eigen::VectorXd q, v;
+  through.Sample(1.25, &q, &v);
+  EXPECT_NEAR(q(0), 0.5, 1e-9);
+  EXPECT_NEAR(v(0), 0.5, 1e-9);
+  EXPECT_GT(TimeParameterize(line, limits, 1.0).duration(), 3.9);  // four stops: 4 x 2 sqrt(0.25) = 4 s
+  EXPECT_THROW(TimeParameterize(line, limits, 1.0, {true, false}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace trimbot::arm

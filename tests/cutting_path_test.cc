@@ -35,16 +35,22 @@ struct Fixture {
   perception::TopiaryShape target;
 
   CuttingChecks checks;
+  double spacing = CuttingPoseOptions{}.spacing;  // m between the blade poses the checks are for
 
-  // A ball of 0.3 m radius in front of the robot; the arm keeps out of it but for the 2 cm a cut
-  // may go deep and still leave the surface within tolerance.
+  // A ball of 0.3 m radius in front of the robot; the arm keeps out of it but for the blade, which
+  // may dip between poses aimed at its surface as deep as a straight cut between neighbours does.
   Fixture() {
     const auto p = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
     T_cutter_blade = robot.BladeInCutter();
     target.centre = {0.95, 0.0, 0.35};
     target.half = Eigen::Vector3d::Constant(0.3);
-    checks = MakeCuttingChecks(kinematics, &collision, target);
+    CheckAgainst(target);
+  }
+  // The checks of blade poses `spacing` apart aimed at `shape`'s surface.
+  void CheckAgainst(const perception::TopiaryShape& shape) {
+    checks = MakeCuttingChecks(kinematics, T_cutter_blade, &collision, shape,
+                               CheckDepth(shape, 0.0, spacing, robot.BladeThickness()));
   }
   bool Valid(const Eigen::VectorXd& q) const { return checks.valid(q); }
   bool FreeMove(const Eigen::VectorXd& a, const Eigen::VectorXd& b) const { return checks.free_move(a, b); }
@@ -100,7 +106,7 @@ void ExpectAdaptedToAMovedBush(Fixture& f, const CuttingPath& path, const Cuttin
   perception::TopiaryShape moved = f.target;
   moved.centre += Eigen::Vector3d(0.03, -0.02, 0.0);
   moved.half = Eigen::Vector3d::Constant(0.32);
-  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, moved);
+  f.CheckAgainst(moved);
   const auto adapt_start = std::chrono::steady_clock::now();
   const CuttingPath adapted = AdaptCuttingPath(
       f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), moved,
@@ -130,7 +136,7 @@ void ExpectAdaptedToATurnedRoundBush(Fixture& f, const CuttingPath& path, const 
   perception::TopiaryShape turned = f.target;
   turned.yaw = 1.3;
   turned.half.x() += 0.005;
-  f.checks = MakeCuttingChecks(f.kinematics, &f.collision, turned);
+  f.CheckAgainst(turned);
   const CuttingPath same = AdaptCuttingPath(
       f.kinematics, f.T_cutter_blade, f.home, ToStored(path, f.target), turned,
       [&](const Eigen::VectorXd& q) { return f.Valid(q); },
@@ -147,6 +153,8 @@ TEST(CuttingPath, ATourOfFreeMovesPutsTheBladeOnEveryReachablePoseOnce) {
   Fixture f;
   CuttingPoseOptions pose_options;
   pose_options.spacing = 0.12;
+  f.spacing = pose_options.spacing;
+  f.CheckAgainst(f.target);
   CuttingPathOptions options;
   options.rolls = 4;
   const std::vector<Eigen::Isometry3d> poses = CuttingPoses(f.target, pose_options);
@@ -338,20 +346,24 @@ void SweepBlade(const Fixture& f, const CuttingPath& path, const Eigen::Isometry
   };
   for (std::size_t i = 0; i < path.planned.size(); ++i) {
     if (path.planned[i]) continue;
-    const Eigen::VectorXd d = f.kinematics.JointDifference(path.configurations[i], path.configurations[i + 1]);
-    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
-    for (int s = 0; s < steps; ++s)
-      foliage->Cut(blade_at(path.configurations[i] + d * (static_cast<double>(s) / steps)),
-                   blade_at(path.configurations[i] + d * (static_cast<double>(s + 1) / steps)));
+    Eigen::VectorXd at = path.configurations[i];
+    for (const Eigen::VectorXd& next : f.checks.way(at, path.configurations[i + 1])) {
+      const Eigen::VectorXd d = next - at;  // the way's steps: <= 0.02 rad or 5 mm of blade travel
+      const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / 0.01)));
+      for (int s = 0; s < steps; ++s)
+        foliage->Cut(blade_at(at + d * (static_cast<double>(s) / steps)),
+                     blade_at(at + d * (static_cast<double>(s + 1) / steps)));
+      at = next;
+    }
   }
 }
 
 // The blocks together, without the simulator: a ball grown 5 cm past its target, trimmed from four
 // standoffs round it (the base 0.95 m from its centre, facing it). At each, the target is fitted to
 // the leaves facing the robot, the cutting path planned on the fit, and the blade swept along the
-// path's straight moves through the foliage. The share of the surface within 2 cm of the target
-// must rise on the side each standoff faces and by 10 points over the whole bush; the over-cut is
-// reported (issue 31's targets, >= 90 % and < 1 %, are for the closed loop).
+// path's free moves (the checks' ways) through the foliage. The share of the surface within 2 cm of
+// the target must rise on the side each standoff faces and by 10 points over the whole bush, and the
+// over-cut stay under issue 31's 1 % (its >= 90 % is for the closed loop).
 TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
   Fixture f;
   const garden::GardenObject bush = TopiaryBall({2.0, 1.0});
@@ -362,6 +374,7 @@ TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
   options.rolls = 4;
   CuttingPoseOptions pose_options;
   pose_options.spacing = 0.1;
+  f.spacing = pose_options.spacing;
   for (int k = 0; k < 4; ++k) {
     const double bearing = M_PI / 2 * k;  // of the base from the bush
     const Eigen::Vector3d towards(std::cos(bearing), std::sin(bearing), 0.0);
@@ -373,7 +386,7 @@ TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
     const auto fit =
         perception::FitTopiary(LeavesSeenFrom(foliage, T_map_base, towards, rng), guess, perception::AxesTied::kAll);
     ASSERT_TRUE(fit);
-    f.checks = MakeCuttingChecks(f.kinematics, &f.collision, fit->shape);
+    f.CheckAgainst(fit->shape);
     const CuttingPath path =
         PlanCuttingPath(f.kinematics, f.T_cutter_blade, f.home, CuttingPoses(fit->shape, pose_options), f.checks.valid,
                         f.checks.free_move, options);
@@ -393,6 +406,8 @@ TEST(CuttingPath, SweepingThePlannedPathsFromFourStandoffsTrimsTheBush) {
       100.0 * before.surface_within_tolerance, 100.0 * after.surface_within_tolerance,
       100.0 * after.overcut_volume / after.target_volume);
   EXPECT_GT(after.surface_within_tolerance, before.surface_within_tolerance + 0.1);
+  // A blade let 2 cm into the fit between poses (straight joint moves, until 2026-12-06) cut 5.7 %.
+  EXPECT_LT(after.overcut_volume / after.target_volume, 0.01) << "issue 31's over-cut target";
 }
 
 }  // namespace

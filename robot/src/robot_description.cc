@@ -160,12 +160,16 @@ std::vector<LinkCylinder> RobotDescription::ArmLinkCylinders() const {
   return cylinders;
 }
 
-double RobotDescription::BladeRadius() const {
+const urdf::Cylinder& RobotDescription::BladeCylinder() const {
   const urdf::Cylinder* cylinder =
       CollisionCylinder(model_->getLink(model_->getJoint(RobotFrames::kCutterJoint)->child_link_name));
   if (cylinder == nullptr) throw InputError(path_, "the cutter blade's link has no collision cylinder");
-  return cylinder->radius;
+  return *cylinder;
 }
+
+double RobotDescription::BladeRadius() const { return BladeCylinder().radius; }
+
+double RobotDescription::BladeThickness() const { return BladeCylinder().length; }
 
 std::pair<Eigen::Vector2d, Eigen::Vector2d> RobotDescription::BaseOutline() const {
   Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());

@@ -66,8 +66,9 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
           const double b = bearing * M_PI / 180.0;
           target.centre = {distance * std::cos(b), distance * std::sin(b), target.half.z()};
           const auto start = std::chrono::steady_clock::now();
-          const trimming::CuttingChecks checks =
-              trimming::MakeCuttingChecks(kinematics, &collision, target, trim.tolerance, trim.planner.collision_step);
+          const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(
+              kinematics, T_cutter_blade, &collision, target,
+              trimming::CheckDepth(target, 0.0, trim.poses.spacing, robot.BladeThickness()), trim.planner);
           const trimming::CuttingPath path =
               trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target, trim.poses),
                                         checks.valid, checks.free_move, path_options);

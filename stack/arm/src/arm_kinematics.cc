@@ -295,6 +295,25 @@ std::optional<Eigen::VectorXd> ArmKinematics::InverseKinematicsNear(const Eigen:
                                                                     const Eigen::VectorXd& seed,
                                                                     const IkOptions& options) const {
   CheckSize(seed);
+  // Gauss-Newton steps (slightly damped) from the seed first: for the small step of the cutter this
+  // is for, two or three of them reach the tolerance, some ten times faster than KDL's
+  // Levenberg-Marquardt, which takes over where they do not.
+  constexpr int kNewtonSteps = 6;
+  constexpr double kDamping = 1e-6;  // lambda^2 of the damped least squares
+  Eigen::VectorXd near = seed;
+  for (int step = 0; step < kNewtonSteps; ++step) {
+    const Eigen::Isometry3d at = EndEffectorPose(near);
+    const Eigen::AngleAxisd turn(target.linear() * at.linear().transpose());
+    Eigen::Matrix<double, 6, 1> error;
+    error << target.translation() - at.translation(), turn.angle() * turn.axis();
+    if (error.head<3>().norm() <= options.position_tolerance && turn.angle() <= options.orientation_tolerance) {
+      if (WithinLimits(near)) return near;
+      break;
+    }
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> J = Jacobian(near);
+    near +=
+        J.transpose() * (J * J.transpose() + kDamping * Eigen::Matrix<double, 6, 6>::Identity()).ldlt().solve(error);
+  }
   KDL::ChainIkSolverPos_LMA solver(chain_->chain, 1e-12, options.max_iterations);
   KDL::JntArray solution(static_cast<unsigned>(joints()));
   solver.CartToJnt(ToKdl(seed), ToKdl(target), solution);

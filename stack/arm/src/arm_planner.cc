@@ -17,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "trimbot/common/pose2.h"
 
@@ -129,13 +130,37 @@ void JointTrajectory::Sample(double t, Eigen::VectorXd* position, Eigen::VectorX
 }
 
 JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& waypoints, const Eigen::VectorXd& velocity_limits,
-                                 double acceleration, double sample_period) {
+                                 double acceleration, const std::vector<bool>& stops, double sample_period) {
+  if (!stops.empty() && stops.size() != waypoints.size())
+    throw std::invalid_argument("TimeParameterize: one stop flag per waypoint");
   std::vector<Piece> pieces;
-  for (size_t k = 1; k < waypoints.size(); ++k) {
-    pieces.emplace_back(std::vector<Eigen::VectorXd>{waypoints[k - 1], waypoints[k]}, velocity_limits, acceleration);
+  std::vector<Eigen::VectorXd> stretch;
+  for (size_t k = 0; k < waypoints.size(); ++k) {
+    stretch.push_back(waypoints[k]);
+    if (k > 0 && (stops.empty() || stops[k] || k + 1 == waypoints.size())) {
+      pieces.emplace_back(stretch, velocity_limits, acceleration);
+      stretch = {waypoints[k]};
+    }
   }
   if (pieces.empty() && !waypoints.empty()) pieces.emplace_back(waypoints, velocity_limits, acceleration);
   return Timed(pieces, sample_period);
+}
+
+std::vector<Eigen::Isometry3d> PosesAlongLine(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double step) {
+  const Eigen::AngleAxisd turn(from.linear().transpose() * to.linear());
+  const double distance = (to.translation() - from.translation()).norm();
+  constexpr double kRadiansPerMetre = 10.0;  // a 5 mm step turns at most 0.05 rad
+  const int steps =
+      std::max(1, static_cast<int>(std::ceil(std::max(distance, turn.angle() / kRadiansPerMetre) / step)));
+  std::vector<Eigen::Isometry3d> poses;
+  for (int k = 1; k <= steps; ++k) {
+    const double s = static_cast<double>(k) / steps;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = from.translation() + s * (to.translation() - from.translation());
+    pose.linear() = from.linear() * Eigen::AngleAxisd(s * turn.angle(), turn.axis()).toRotationMatrix();
+    poses.push_back(pose);
+  }
+  return poses;
 }
 
 // ---------------------------------------------------------------- OMPL
@@ -353,18 +378,12 @@ std::optional<Eigen::VectorXd> ArmPlanner::NearestSolution(const Eigen::Isometry
 ArmPlan ArmPlanner::CartesianPass(const Eigen::VectorXd& start, const Eigen::Isometry3d& to) {
   const auto begin = std::chrono::steady_clock::now();
   ArmPlan plan;
-  const Eigen::Isometry3d from = kinematics_.EndEffectorPose(start);
-  const Eigen::AngleAxisd turn(from.linear().transpose() * to.linear());
-  const double distance = (to.translation() - from.translation()).norm();
-  constexpr double kRadiansPerMetre = 10.0;  // a step turns the cutter at most 0.05 rad per 5 mm
-  const int steps = std::max(
-      1, static_cast<int>(std::ceil(std::max(distance, turn.angle() / kRadiansPerMetre) / parameters_.cartesian_step)));
+  const std::vector<Eigen::Isometry3d> line =
+      PosesAlongLine(kinematics_.EndEffectorPose(start), to, parameters_.cartesian_step);
   plan.waypoints.push_back(start);
-  for (int k = 1; k <= steps; ++k) {
-    const double s = static_cast<double>(k) / steps;
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.translation() = from.translation() + s * (to.translation() - from.translation());
-    pose.linear() = from.linear() * Eigen::AngleAxisd(s * turn.angle(), turn.axis()).toRotationMatrix();
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    const Eigen::Isometry3d& pose = line[k];
+    const double s = static_cast<double>(k + 1) / line.size();
     const Eigen::VectorXd& previous = plan.waypoints.back();
     std::optional<Eigen::VectorXd> q = kinematics_.InverseKinematicsNear(pose, previous, parameters_.ik);
     std::string lost;

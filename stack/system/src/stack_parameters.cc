@@ -262,10 +262,7 @@ void ReadTrim(Reader& r, trimming::TrimParameters& p) {
   r.Integer("rolls", &p.path.rolls, 1, 360);
   r.Integer("search_restarts", &p.path.search.restarts, 1, 1000);
   r.Integer("search_warm_restarts", &p.path.search.warm_restarts, 0, 1000);
-  r.Number("tolerance", &p.tolerance, 0.0, 0.2, "m");
   r.Number("blade_depth", &p.blade_depth, 0.0, 0.2, "m");
-  if (p.blade_depth > p.tolerance)
-    r.map().Fail("blade_depth", "must not exceed tolerance (the collision checks' depth)");
   r.Number("leaf_quantile", &p.leaf_quantile, 0.5, 1.0);
   r.Number("leaf_clearance", &p.leaf_clearance, 0.0, 0.5, "m");
   r.Number("database_max_distance", &p.database_max_distance, 0.0, 10.0, "m");

@@ -93,13 +93,15 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
 }
 
 void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset) {
-  // The target's surface moved along its radii on a polar grid (rings x segments plus the two
-  // poles), as a convex polyhedron (a superellipsoid of exponents >= 2 is convex).
+  // The target with its semi-axes moved by `offset` (as the surface the blade is aimed at is: on a
+  // box's faces that moves the surface along its normal, where a move along the radii would move an
+  // oblique part of a face by less), on a polar grid (rings x segments plus the two poles), as a
+  // convex polyhedron (a superellipsoid of exponents >= 2 is convex).
   constexpr int kRings = 16, kSegments = 32;
+  perception::TopiaryShape moved = target;
+  moved.half = (target.half.array() + offset).max(1e-3).matrix();
   std::vector<Eigen::Vector3d> vertices;
-  const auto surface = [&](const Eigen::Vector3d& d) {
-    return Eigen::Vector3d(target.centre + std::max(0.0, target.Radius(d) + offset) * d);
-  };
+  const auto surface = [&](const Eigen::Vector3d& d) { return Eigen::Vector3d(target.centre + moved.Radius(d) * d); };
   vertices.push_back(surface(Eigen::Vector3d::UnitZ()));
   for (int r = 1; r < kRings; ++r) {
     const double polar = M_PI * r / kRings;
@@ -126,21 +128,60 @@ void SetTargetEnvironment(robot::CollisionModel* collision, const perception::To
   collision->environment().AddConvex("target", vertices, triangles);
 }
 
-CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
-                                const perception::TopiaryShape& target, double tolerance, double step,
+double CheckDepth(const perception::TopiaryShape& target, double aimed_depth, double spacing, double blade_thickness) {
+  const double radius = std::max(1e-3, target.half.minCoeff() - aimed_depth);
+  const double neighbours = spacing * std::sqrt(2.0 / std::sqrt(3.0));
+  return aimed_depth + 0.5 * blade_thickness + neighbours * neighbours / (8.0 * radius);
+}
+
+std::vector<Eigen::VectorXd> BladeLine(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                                       const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                       const arm::ArmPlannerParameters& arm_parameters,
+                                       const std::function<bool(const Eigen::VectorXd&)>& valid) {
+  const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
+  const std::vector<Eigen::Isometry3d> line =
+      arm::PosesAlongLine(kinematics.EndEffectorPose(a) * T_cutter_blade,
+                          kinematics.EndEffectorPose(b) * T_cutter_blade, arm_parameters.cartesian_step);
+  // No joint turns more than cartesian_max_joint_step a step: b on another branch is out of reach.
+  const double most = arm_parameters.cartesian_max_joint_step * static_cast<double>(line.size());
+  if (kinematics.JointDifference(a, b).cwiseAbs().maxCoeff() > most) return {};
+  std::vector<Eigen::VectorXd> configurations;
+  Eigen::VectorXd previous = a;
+  for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+    const std::optional<Eigen::VectorXd> q =
+        kinematics.InverseKinematicsNear(line[k] * T_blade_cutter, previous, arm_parameters.ik);
+    if (!q || (*q - previous).cwiseAbs().maxCoeff() > arm_parameters.cartesian_max_joint_step) return {};
+    if (valid && !valid(*q)) return {};
+    configurations.push_back(*q);
+    previous = *q;
+  }
+  const Eigen::VectorXd end = previous + kinematics.JointDifference(previous, b);  // b, on the way's unwrapping
+  if ((end - previous).cwiseAbs().maxCoeff() > arm_parameters.cartesian_max_joint_step) return {};  // another branch
+  if (valid && !valid(end)) return {};
+  configurations.push_back(end);
+  return configurations;
+}
+
+CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                                robot::CollisionModel* collision, const perception::TopiaryShape& target, double depth,
+                                const arm::ArmPlannerParameters& arm_parameters,
                                 const std::function<bool(const Eigen::VectorXd&)>& also_valid) {
-  SetTargetEnvironment(collision, target, -tolerance);
+  SetTargetEnvironment(collision, target, -depth);
   CuttingChecks checks;
   checks.valid = [collision, also_valid](const Eigen::VectorXd& q) {
     return !collision->Check(q).collision && (!also_valid || also_valid(q));
   };
-  checks.free_move = [&kinematics, valid = checks.valid, step](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  checks.way = [&kinematics, T_cutter_blade, arm_parameters, valid = checks.valid](const Eigen::VectorXd& a,
+                                                                                   const Eigen::VectorXd& b) {
     const Eigen::VectorXd d = kinematics.JointDifference(a, b);
-    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / step)));
-    for (int k = 1; k <= steps; ++k) {
-      if (!valid(a + d * (static_cast<double>(k) / steps))) return false;
-    }
-    return true;
+    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / arm_parameters.collision_step)));
+    std::vector<Eigen::VectorXd> way;
+    for (int k = 1; k <= steps; ++k) way.push_back(a + d * (static_cast<double>(k) / steps));
+    if (std::all_of(way.begin(), way.end(), valid)) return way;
+    return BladeLine(kinematics, T_cutter_blade, a, b, arm_parameters, valid);
+  };
+  checks.free_move = [way = checks.way](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return !way(a, b).empty();
   };
   return checks;
 }

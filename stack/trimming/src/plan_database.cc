@@ -205,24 +205,34 @@ CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::
     const bool first = path.configurations.size() == 1;  // the move from the start is the arm planner's
     std::optional<Eigen::VectorXd> q =
         kinematics.InverseKinematicsNear(blade * T_blade_cutter, stored.configurations[k], options.ik);
-    if (q && !(valid(*q) && (first || free_move(previous, *q)))) q.reset();
-    if (!q) {
-      // Repair locally: the quickest free move to any of the pose's solutions, else leave the pose.
-      double best = std::numeric_limits<double>::infinity();
+    if (q && !valid(*q)) q.reset();
+    bool free = q && (first || free_move(previous, *q));
+    if (!free) {
+      // Repair locally: the quickest free move to any of the pose's solutions, else the valid one
+      // nearest in time (a planned move), else leave the pose.
+      double best_free = std::numeric_limits<double>::infinity(), best = best_free;
+      std::optional<Eigen::VectorXd> nearest;
       for (const Eigen::VectorXd& other : kinematics.InverseKinematics(blade * T_blade_cutter, options.ik).solutions) {
         const double time = JointMoveTime(kinematics, previous, other, options.velocity_scale, options.acceleration);
-        if (time < best && valid(other) && (first || free_move(previous, other))) {
+        if (!valid(other)) continue;
+        if (time < best) {
           best = time;
+          nearest = other;
+        }
+        if (time < best_free && (first || free_move(previous, other))) {
+          best_free = time;
           q = other;
+          free = true;
         }
       }
+      if (!free) q = nearest;
       ++path.refused_moves;
     }
     if (!q) {
       path.unreachable.push_back(static_cast<int>(k));
       continue;
     }
-    path.planned.push_back(first);
+    path.planned.push_back(first || !free);
     path.configurations.push_back(*q);
     path.poses.push_back(static_cast<int>(k));
     path.blades.push_back(blade);

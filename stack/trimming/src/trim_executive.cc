@@ -57,6 +57,7 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
       kinematics_(description),
       T_cutter_blade_(description.BladeInCutter()),
       blade_radius_(description.BladeRadius()),
+      blade_thickness_(description.BladeThickness()),
       housing_radius_(description.ArmLinkCylinders().back().radius),  // link 6 carries the cutter
       collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
       planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
@@ -199,9 +200,10 @@ void TrimExecutive::Plan(double stamp) {
   const auto begin = std::chrono::steady_clock::now();
   const perception::TopiaryShape& target = target_shape_;
   std::string failure;
-  const CuttingChecks checks = MakeCuttingChecks(kinematics_, collision_.get(), target, parameters_.tolerance,
-                                                 parameters_.planner.collision_step,
-                                                 [this](const Eigen::VectorXd& q) { return !ArmInLeaves(q); });
+  check_depth_ = CheckDepth(target, parameters_.blade_depth, parameters_.poses.spacing, blade_thickness_);
+  const CuttingChecks checks =
+      MakeCuttingChecks(kinematics_, T_cutter_blade_, collision_.get(), target, check_depth_, parameters_.planner,
+                        [this](const Eigen::VectorXd& q) { return !ArmInLeaves(q); });
   planner_->ResetRoadmap();
   // Where the blade goes: the fitted surface, or blade_depth inside it.
   perception::TopiaryShape blade_surface = target;
@@ -241,7 +243,7 @@ void TrimExecutive::Plan(double stamp) {
   }
   report_.reached = static_cast<int>(path.poses.size());
   report_.motion_time = path.motion_time;
-  const std::vector<Eigen::VectorXd> waypoints = Waypoints(path, &failure);
+  const std::vector<Eigen::VectorXd> waypoints = Waypoints(path, checks, &failure);
   report_.planning_seconds += SecondsSince(begin);
   if (waypoints.empty()) {
     Finish(stamp, failure);
@@ -251,13 +253,13 @@ void TrimExecutive::Plan(double stamp) {
   for (int i = 0; i < kinematics_.joints(); ++i) {
     limits(i) = parameters_.planner.velocity_scale * kinematics_.limits()[static_cast<std::size_t>(i)].velocity;
   }
-  trajectory_ = arm::TimeParameterize(waypoints, limits, parameters_.planner.acceleration);
+  trajectory_ = arm::TimeParameterize(waypoints, limits, parameters_.planner.acceleration, stops_);
   report_.cutting_duration = trajectory_.duration();
-  // Rest-to-rest segments: the parts' durations add up.
+  // The arm stops at the first and the last blade waypoint: the parts' durations add up.
   const auto duration = [&](std::size_t from, std::size_t to) {
-    return arm::TimeParameterize({waypoints.begin() + static_cast<std::ptrdiff_t>(from),
-                                  waypoints.begin() + static_cast<std::ptrdiff_t>(to) + 1},
-                                 limits, parameters_.planner.acceleration)
+    const auto begin = static_cast<std::ptrdiff_t>(from), end = static_cast<std::ptrdiff_t>(to) + 1;
+    return arm::TimeParameterize({waypoints.begin() + begin, waypoints.begin() + end}, limits,
+                                 parameters_.planner.acceleration, {stops_.begin() + begin, stops_.begin() + end})
         .duration();
   };
   cut_begins_ = duration(0, first_blade_waypoint_);
@@ -267,13 +269,13 @@ void TrimExecutive::Plan(double stamp) {
   mode_ = Mode::kCutting;
 }
 
-std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, std::string* failure) {
+std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, const CuttingChecks& checks,
+                                                      std::string* failure) {
   const std::vector<Eigen::VectorXd>& q = path.configurations;  // the start, the blade poses, the start
   const std::size_t last = q.size() - 2;                        // the last blade pose
-  // In round the leaves to the first blade pose that has such a way, out from the last: the poses
-  // before and after those are left out (a blade pose hard against the base cannot be drawn back
-  // along its axis), at most kMaxLeftOut at either end; beyond that the move goes round the shrunk
-  // target as any other planned move, through the leaves.
+  // In round the leaves to the first blade pose that has such a way, out from the last: the poses before and
+  // after those are left out (a blade pose hard against the base cannot be drawn back along its axis), at most
+  // kMaxLeftOut at either end; beyond that the move goes round the shrunk target as any planned move does.
   constexpr std::size_t kMaxLeftOut = 3;
   const auto way_round = [&](std::size_t k) {
     return IntoTheLeaves(q.front(), q.front() + kinematics_.JointDifference(q.front(), q[k]));
@@ -291,8 +293,15 @@ std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, s
   }
   report_.left_out = static_cast<int>((first - 1) + (last - final));
   std::vector<Eigen::VectorXd> waypoints{q.front()};
-  const auto append = [&](const std::vector<Eigen::VectorXd>& way) {
+  stops_ = {true};
+  const auto append = [&](const std::vector<Eigen::VectorXd>& way) {  // stopping at each of its waypoints
     waypoints.insert(waypoints.end(), way.begin() + 1, way.end());
+    stops_.resize(waypoints.size(), true);
+  };
+  const auto along = [&](const std::vector<Eigen::VectorXd>& line) {  // a free move: stopping at its end only
+    waypoints.insert(waypoints.end(), line.begin(), line.end());
+    stops_.resize(waypoints.size(), false);
+    stops_.back() = true;
   };
   const auto plan_round_target = [&](const Eigen::VectorXd& to, std::size_t pose) {
     const arm::ArmPlan plan = planner_->PlanToJoints(waypoints.back(), to);
@@ -313,20 +322,19 @@ std::vector<Eigen::VectorXd> TrimExecutive::Waypoints(const CuttingPath& path, s
   first_blade_waypoint_ = waypoints.size() - 1;
   for (std::size_t i = first; i < final; ++i) {
     const Eigen::VectorXd to = waypoints.back() + kinematics_.JointDifference(waypoints.back(), q[i + 1]);
-    // A straight move that keeps the blade's turn and its tilt off the surface small stays in the
-    // swath it cuts; any other goes out along the axis, round the leaves and in (where it can), not
-    // through them.
-    const bool straight = !path.planned[i];
-    std::vector<Eigen::VectorXd> way;
-    if (!straight || BladeTurn(waypoints.back(), to) > MaxTurnInLeaves() ||
-        MaxTiltAlong(waypoints.back(), to) > MaxTurnInLeaves()) {
-      way = RoundTheLeaves(waypoints.back(), to);
-    }
+    // A free move (the checks' way) that keeps the blade's turn and its tilt off the surface small stays in the
+    // swath it cuts; any other goes out along the axis, round the leaves and in (where it can), not through them.
+    const std::vector<Eigen::VectorXd> move =
+        path.planned[i] ? std::vector<Eigen::VectorXd>{} : checks.way(waypoints.back(), to);
+    const bool in_swath =
+        !move.empty() && BladeTurn(waypoints.back(), to) <= MaxTurnInLeaves() && MaxTilt(move) <= MaxTurnInLeaves();
+    const std::vector<Eigen::VectorXd> way =
+        in_swath ? std::vector<Eigen::VectorXd>{} : RoundTheLeaves(waypoints.back(), to);
     if (!way.empty()) {
       append(way);
       ++report_.turns_round_the_leaves;
-    } else if (straight) {
-      waypoints.push_back(to);
+    } else if (!move.empty()) {
+      along(move);
     } else if (!plan_round_target(to, i)) {
       return {};
     }
@@ -361,7 +369,7 @@ std::vector<Eigen::VectorXd> TrimExecutive::IntoTheLeaves(const Eigen::VectorXd&
   SetTargetEnvironment(collision_.get(), target_shape_, report_.leaf_depth + parameters_.leaf_clearance);
   planner_->ResetRoadmap();
   const arm::ArmPlan round = planner_->PlanToJoints(outside, drawn_back.back());
-  SetTargetEnvironment(collision_.get(), target_shape_, -parameters_.tolerance);
+  SetTargetEnvironment(collision_.get(), target_shape_, -check_depth_);
   planner_->ResetRoadmap();
   if (!round.ok) return {};
   std::vector<Eigen::VectorXd> way = round.waypoints;
@@ -397,14 +405,10 @@ bool TrimExecutive::ArmInLeaves(const Eigen::VectorXd& q) const {
   return false;
 }
 
-double TrimExecutive::MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
-  const Eigen::VectorXd d = to - from;  // unwrapped: the move the trajectory makes
-  const int steps =
-      std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / parameters_.planner.collision_step)));
+double TrimExecutive::MaxTilt(const std::vector<Eigen::VectorXd>& way) const {
   double tilt = 0.0;
-  for (int k = 0; k <= steps; ++k) {
-    const Eigen::Isometry3d blade =
-        kinematics_.EndEffectorPose(from + d * (static_cast<double>(k) / steps)) * T_cutter_blade_;
+  for (const Eigen::VectorXd& q : way) {
+    const Eigen::Isometry3d blade = kinematics_.EndEffectorPose(q) * T_cutter_blade_;
     const Eigen::Vector3d inward = -SurfaceNormal(target_shape_, blade.translation());
     tilt = std::max(tilt, std::acos(std::clamp(inward.dot(blade.linear().col(2)), -1.0, 1.0)));
   }

@@ -48,8 +48,9 @@ class RobotDescription {
   // The cutter blade's frame (the child of cutter_blade_joint: the disc about its z axis) in the
   // cutter frame (arm_end_effector), the blade at zero turn.
   Eigen::Isometry3d BladeInCutter() const;
-  // The blade disc's radius (m): its link's collision cylinder.
+  // The blade disc's radius and thickness (m): its link's collision cylinder.
   double BladeRadius() const;
+  double BladeThickness() const;
   // Pose of a child link in its parent link for the joint at position q.
   static Eigen::Isometry3d JointTransform(const urdf::Joint& joint, double q);
 
@@ -68,6 +69,8 @@ class RobotDescription {
   double Top(const std::map<std::string, double>& joint_positions = {}) const;
 
  private:
+  const urdf::Cylinder& BladeCylinder() const;  // InputError when the blade's link has none
+
   std::string path_;
   urdf::ModelInterfaceSharedPtr model_;
   DiffDriveGeometry drive_;

@@ -94,9 +94,17 @@ class ArmPlanner {
   std::unique_ptr<Ompl> ompl_;
 };
 
-// Times a joint-space path: each segment is a straight line, started and ended at rest with a
-// trapezoidal speed profile, every joint within `velocity_limits` and `acceleration`.
+// Times a joint-space path through `waypoints` (straight lines between them), every joint within
+// `velocity_limits` and `acceleration`, with a trapezoidal speed profile from rest to rest over each
+// stretch between stops: the arm stops at waypoint k when stops[k] (at every one when `stops` is
+// empty; always at the ends). Waypoints it passes through should lie on a smooth path (the steps of a
+// Cartesian line): the profile does not slow for corners.
 JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& waypoints, const Eigen::VectorXd& velocity_limits,
-                                 double acceleration, double sample_period = 0.02);
+                                 double acceleration, const std::vector<bool>& stops = {}, double sample_period = 0.02);
+
+// The poses after `from` up to `to` along the straight line between them (position linearly,
+// orientation by the shortest rotation), `step` metres of travel or 10 * `step` radians of turn
+// apart, whichever makes more: the steps of a Cartesian pass.
+std::vector<Eigen::Isometry3d> PosesAlongLine(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double step);
 
 }  // namespace trimbot::arm

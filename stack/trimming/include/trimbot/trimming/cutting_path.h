@@ -4,16 +4,19 @@
 // collision-free inverse-kinematics solutions of each pose as one GTSP cluster (the blade spins,
 // so its roll about its axis is free: several rolls per pose), the edge cost the time of a
 // rest-to-rest joint move between two solutions, and a tour through one solution of every pose.
-// Moves between blade poses are straight joint moves where the collision check lets them be;
-// where it refuses one, the arm planner plans it round obstacles, costed as the way through the
-// start, and the tour is solved again (lazy edge checking: only the moves a tour makes, and their
-// poses' other solutions, are checked). The moves from the start and back are the planner's too.
+// Moves between blade poses are straight blade moves (BladeLine: the blade along the line between
+// them, as a hand would guide a hedge trimmer) where the collision check lets them be; where it
+// refuses one, the arm planner plans it round obstacles, costed as the way through the start, and
+// the tour is solved again (lazy edge checking: only the moves a tour makes, and their poses' other
+// solutions, are checked). The moves from the start and back are the planner's too. A tour's cost
+// counts each blade move as the straight joint move between its ends.
 #include <Eigen/Geometry>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "trimbot/arm/arm_kinematics.h"
+#include "trimbot/arm/arm_planner.h"
 #include "trimbot/perception/topiary_fit.h"
 #include "trimbot/robot/collision_model.h"
 #include "trimbot/trimming/gtsp.h"
@@ -73,22 +76,50 @@ struct CuttingPath {
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration);
 
-// The arm's collision model's environment: the ground and the target's surface moved `offset`
-// outward along its radii (negative: into it) as a solid convex polyhedron.
+// The arm's collision model's environment: the ground and the target with its semi-axes moved
+// `offset` outward (negative: inward; as BladePoseAt's surface is moved by the blade's depth) as a
+// solid convex polyhedron.
 void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset);
 
+// How deep into the target the collision checks let the blade go: as deep as it is aimed
+// (`aimed_depth`, its disc's mid-plane, where the blade cuts), half the disc's thickness (its
+// collision cylinder's lower face), plus the sagitta of a straight blade move between neighbouring poses over the
+// target's smallest semi-axis (where a ball or the rim of a cylinder curves most). Neighbours: the
+// poses' lattice holds one per spacing^2 of surface, hexagonal neighbours sqrt(2 / sqrt(3)) spacing
+// apart. A move that dips further (one that skips a pose) is refused and planned round. Not the
+// 2 cm of the cut criterion: a blade let that deep cuts into the target wherever the fit stands
+// less than 2 cm over it (docs/design.md, Trimming).
+double CheckDepth(const perception::TopiaryShape& target, double aimed_depth, double spacing, double blade_thickness);
+
+// The blade's straight move from configuration `a` to `b`: the blade's disc (`T_cutter_blade` in
+// the cutter frame) along the line between where a and b put it (PosesAlongLine, the arm's
+// cartesian_step), the arm following on a's branch by inverse kinematics from each step to the
+// next. The configurations after `a`, the last one `b` (continuous joints unwrapped along the
+// way); empty when the arm loses the line, would switch branch (a step over
+// cartesian_max_joint_step), arrives at another solution than b, or `valid` (when given) refuses a
+// step.
+std::vector<Eigen::VectorXd> BladeLine(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                                       const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                                       const arm::ArmPlannerParameters& arm_parameters,
+                                       const std::function<bool(const Eigen::VectorXd&)>& valid = {});
+
 // The collision checks of a cutting path on the arm's collision model, whose environment becomes
-// the ground and the target shrunk by `tolerance` as a solid (convex) polyhedron: the blade may go
-// that deep, and the surface it leaves stays within tolerance of the target. `also_valid`, when
-// given, is a further condition on each configuration (the executive's: no arm link but the
-// cutter's in the leaves the scan saw). A move is free when its configurations `step` apart (rad,
-// continuous joints the short way round) are.
+// the ground and the target shrunk by `depth` (CheckDepth) as a solid (convex) polyhedron: the
+// blade may go that deep. `also_valid`, when given, is a further condition on each configuration
+// (the executive's: no arm link but the cutter's in the leaves the scan saw). A move between two
+// configurations is the straight joint move where its configurations collision_step apart (rad,
+// continuous joints the short way round) are valid, else the blade line (BladeLine) where each of
+// its steps is (5 mm of blade travel apart: what lies between is checked by neither).
 struct CuttingChecks {
   std::function<bool(const Eigen::VectorXd&)> valid;
-  std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)> free_move;
+  // The configurations of the move from a to b after a (the last b, unwrapped from a), checked;
+  // empty when neither move is free.
+  std::function<std::vector<Eigen::VectorXd>(const Eigen::VectorXd&, const Eigen::VectorXd&)> way;
+  std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)> free_move;  // !way(a, b).empty()
 };
-CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, robot::CollisionModel* collision,
-                                const perception::TopiaryShape& target, double tolerance = 0.02, double step = 0.02,
+CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
+                                robot::CollisionModel* collision, const perception::TopiaryShape& target, double depth,
+                                const arm::ArmPlannerParameters& arm_parameters = {},
                                 const std::function<bool(const Eigen::VectorXd&)>& also_valid = {});
 
 // `valid(q)`: the configuration is free; `free_move(a, b)`: the straight joint move is free.

@@ -17,8 +17,9 @@
 //                          way in and out)
 //     -> done              the arm back at its start; report()
 //
-// The collision model's environment is the ground and the fitted target shrunk by the cut's
-// tolerance (MakeCuttingChecks): the leaves outside it are what the blade is there to cut. For
+// The collision model's environment is the ground and the fitted target shrunk by as deep as the
+// blade is aimed and a straight cut between its poses dips (CheckDepth, MakeCuttingChecks): the
+// leaves outside it are what the blade is there to cut. For
 // the moves in and out it is the target grown by the leaves' depth the scan measured, so no link
 // but the blade goes into them. While cutting, the links but the cutter's keep out of those
 // leaves too (ArmInLeaves). Nothing here sees ground truth.
@@ -51,8 +52,7 @@ struct TrimParameters {
   perception::TopiaryFitOptions fit;
   CuttingPoseOptions poses;
   CuttingPathOptions path;
-  double tolerance = 0.02;              // m the blade may go into the fitted target
-  double blade_depth = 0.01;            // m inside the fitted surface the blade is aimed at (<= tolerance)
+  double blade_depth = 0.01;            // m inside the fitted surface the blade is aimed at
   double leaf_quantile = 0.95;          // of the bush's points' distances outside the fit: the leaves' depth
   double leaf_clearance = 0.03;         // m kept from the leaves moving in and out
   double database_max_distance = 0.15;  // m: a stored target farther than this is solved in full
@@ -138,9 +138,10 @@ class TrimExecutive {
   std::vector<Eigen::Vector3d> BushPoints() const;
   // This scan's bush points and the bush's earlier scans (map frame), thinned, in base_link.
   std::vector<Eigen::Vector3d> ScansOfTheBush();
-  // The joint path through the cutting path's configurations (planned moves round the target),
-  // continuous joints unwrapped from the start; empty with *failure set when a move cannot be planned.
-  std::vector<Eigen::VectorXd> Waypoints(const CuttingPath& path, std::string* failure);
+  // The joint path through the cutting path's configurations (its free moves as `checks` make them,
+  // planned moves round the target), continuous joints unwrapped from the start, and stops_; empty
+  // with *failure set when a move cannot be planned.
+  std::vector<Eigen::VectorXd> Waypoints(const CuttingPath& path, const CuttingChecks& checks, std::string* failure);
   // From `outside` (clear of the leaves) to `at_blade` (a blade pose): round the leaves as the scan
   // saw them to the blade pose drawn back along the blade's axis, then in along it. Starts at
   // `outside`; ends where `at_blade` puts the blade (continuous joints maybe a turn off); empty
@@ -160,10 +161,10 @@ class TrimExecutive {
   // leaning by more than this off the axis passes from beside the swath into the housing.
   double MaxTurnInLeaves() const;
   // The largest angle between the blade's axis and the fitted surface's normal at the blade's
-  // centre along the straight joint move from `from` to `to` (sampled as the collision checks
-  // are): a move between two blade poses, each tangent to the surface, can tilt the blade far off
-  // it on the way (the wrist's joints interpolated), though the two poses' axes are close.
-  double MaxTiltAlong(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+  // centre over the configurations of a free move (CuttingChecks::way): a move between two blade
+  // poses, each tangent to the surface, can tilt the blade far off it on the way (the wrist's joints
+  // interpolated), though the two poses' axes are close.
+  double MaxTilt(const std::vector<Eigen::VectorXd>& way) const;
   // Whether an arm link other than the cutter's reaches into the leaves as the scan saw them (the
   // fitted target grown by leaf_depth): points 1 cm apart on each link's collision cylinder's axis,
   // within the cylinder's radius of that surface along the ray from the target's centre. The
@@ -177,6 +178,7 @@ class TrimExecutive {
   arm::ArmKinematics kinematics_;
   Eigen::Isometry3d T_cutter_blade_;
   double blade_radius_ = 0.0, housing_radius_ = 0.0;  // m: the disc's, the cutter housing's (its link's cylinder)
+  double blade_thickness_ = 0.0;                      // m: the disc's
   // The collision cylinders of the arm's links but the cutter's, each with its link's index in
   // kinematics_.links().
   std::vector<std::pair<std::size_t, robot::LinkCylinder>> arm_links_;
@@ -192,6 +194,7 @@ class TrimExecutive {
   Eigen::Isometry3d T_map_base_ = Eigen::Isometry3d::Identity();  // estimated, at the scan
   std::map<int, std::vector<Eigen::Vector3d>> scans_;             // each bush's scans, map frame
   perception::TopiaryShape target_shape_;                         // fitted, in the current base_link
+  double check_depth_ = 0.0;  // m into target_shape_ the collision checks let the blade go (CheckDepth)
   std::vector<Eigen::Vector3d> points_;
   std::vector<Eigen::Matrix3d> covariances_;
   std::optional<messages::ArmJointState> joints_;
@@ -199,6 +202,7 @@ class TrimExecutive {
   double motion_start_ = 0.0, settle_start_ = 0.0;
   double cut_begins_ = 0.0, cut_ends_ = 0.0;                        // s into trajectory_
   std::size_t first_blade_waypoint_ = 0, last_blade_waypoint_ = 0;  // in Waypoints()' result
+  std::vector<bool> stops_;  // per waypoint of Waypoints()' result: the arm stops there (not within a free move)
   Eigen::VectorXd target_;
   TrimReport report_;
 };
