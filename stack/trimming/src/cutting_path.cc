@@ -92,14 +92,17 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
   return poses;
 }
 
-void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset) {
-  // The target with its semi-axes moved by `offset` (as the surface the blade is aimed at is: on a
-  // box's faces that moves the surface along its normal, where a move along the radii would move an
-  // oblique part of a face by less), on a polar grid (rings x segments plus the two poles), as a
-  // convex polyhedron (a superellipsoid of exponents >= 2 is convex).
-  constexpr int kRings = 16, kSegments = 32;
+perception::TopiaryShape Offset(const perception::TopiaryShape& target, double offset) {
   perception::TopiaryShape moved = target;
   moved.half = (target.half.array() + offset).max(1e-3).matrix();
+  return moved;
+}
+
+void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset) {
+  // The offset target on a polar grid (rings x segments plus the two poles), as a convex
+  // polyhedron (a superellipsoid of exponents >= 2 is convex).
+  constexpr int kRings = 16, kSegments = 32;
+  const perception::TopiaryShape moved = Offset(target, offset);
   std::vector<Eigen::Vector3d> vertices;
   const auto surface = [&](const Eigen::Vector3d& d) { return Eigen::Vector3d(target.centre + moved.Radius(d) * d); };
   vertices.push_back(surface(Eigen::Vector3d::UnitZ()));

@@ -206,8 +206,7 @@ void TrimExecutive::Plan(double stamp) {
                         [this](const Eigen::VectorXd& q) { return !ArmInLeaves(q); });
   planner_->ResetRoadmap();
   // Where the blade goes: the fitted surface, or blade_depth inside it.
-  perception::TopiaryShape blade_surface = target;
-  blade_surface.half -= Eigen::Vector3d::Constant(parameters_.blade_depth);
+  const perception::TopiaryShape blade_surface = Offset(target, -parameters_.blade_depth);
   const Eigen::VectorXd start = ToVector(*joints_);
   CuttingPath path;
   double distance = 0.0;

@@ -4,10 +4,10 @@
 // collision-free inverse-kinematics solutions of each pose as one GTSP cluster (the blade spins,
 // so its roll about its axis is free: several rolls per pose), the edge cost the time of a
 // rest-to-rest joint move between two solutions, and a tour through one solution of every pose.
-// Moves between blade poses are straight blade moves (BladeLine: the blade along the line between
-// them, as a hand would guide a hedge trimmer) where the collision check lets them be; where it
-// refuses one, the arm planner plans it round obstacles, costed as the way through the start, and
-// the tour is solved again (lazy edge checking: only the moves a tour makes, and their poses' other
+// Moves between blade poses are straight joint moves, or else straight blade moves (BladeLine: the
+// blade along the line between them, as a hand would guide a hedge trimmer), where the collision
+// check lets them be; where it refuses both, the arm planner plans it round obstacles, costed as the way through the
+// start, and the tour is solved again (lazy edge checking: only the moves a tour makes, and their poses' other
 // solutions, are checked). The moves from the start and back are the planner's too. A tour's cost
 // counts each blade move as the straight joint move between its ends.
 #include <Eigen/Geometry>
@@ -76,9 +76,13 @@ struct CuttingPath {
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration);
 
-// The arm's collision model's environment: the ground and the target with its semi-axes moved
-// `offset` outward (negative: inward; as BladePoseAt's surface is moved by the blade's depth) as a
-// solid convex polyhedron.
+// `target` with its semi-axes moved `offset` outward (negative: inward, to 1 mm at least): on a box's
+// faces that moves the surface along its normal, where a move along the radii would move an oblique
+// part of a face by less. The surface the blade is aimed at and the collision checks' are both this.
+perception::TopiaryShape Offset(const perception::TopiaryShape& target, double offset);
+
+// The arm's collision model's environment: the ground and Offset(target, offset) as a solid convex
+// polyhedron.
 void SetTargetEnvironment(robot::CollisionModel* collision, const perception::TopiaryShape& target, double offset);
 
 // How deep into the target the collision checks let the blade go: as deep as it is aimed
@@ -122,7 +126,7 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, const Eige
                                 const arm::ArmPlannerParameters& arm_parameters = {},
                                 const std::function<bool(const Eigen::VectorXd&)>& also_valid = {});
 
-// `valid(q)`: the configuration is free; `free_move(a, b)`: the straight joint move is free.
+// `valid(q)`: the configuration is free; `free_move(a, b)`: the move from a to b is (CuttingChecks::way).
 // `T_cutter_blade`: the blade's disc in the cutter frame (from the URDF).
 CuttingPath PlanCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
                             const Eigen::VectorXd& start, const std::vector<Eigen::Isometry3d>& blade_poses,
