@@ -135,6 +135,7 @@ TEST(BadInput, RelationsAndRangesAreChecked) {
   const std::vector<BadInput> scenarios = {
       {"outlier_min > outlier_max", with("outlier_min: 0.5", "outlier_min: 5.0"), "outlier_max"},
       {"latency_max < latency_median", with("latency_max: 1.0", "latency_max: 0.1"), "latency_max"},
+      {"fixes stating no error", with("position_sigma: 0.1", "position_sigma: 0.0"), "position_sigma"},
       {"negative yaw sigma", with("yaw_sigma_deg: 2.0", "yaw_sigma_deg: -3"), "yaw_sigma_deg"},
       {"negative trials", with("trials: 2", "trials: -1"), "trials"},
       {"fractional trials", with("trials: 2", "trials: 1.5"), "trials"},

@@ -47,8 +47,11 @@ SimulatedPoseFixParameters ReadSimulatedPoseFixes(const YamlMap& map) {
   SimulatedPoseFixParameters p;
   p.availability = map.NumberOr("availability", p.availability, 0.0, 1.0);
   p.outage_mean_duration = map.NumberOr("outage_mean_duration", p.outage_mean_duration, 0.0, 3600.0, "s");
-  p.position_sigma = map.NumberOr("position_sigma", p.position_sigma, 0.0, 100.0, "m");
-  p.yaw_sigma = map.NumberOr("yaw_sigma_deg", p.yaw_sigma * 180.0 / M_PI, 0.0, 180.0, "deg") * M_PI / 180.0;
+  // The fixes state their covariance from these, and the EKF refuses a fix whose covariance is not
+  // positive definite: zero would have every fix refused (the drive on odometry alone), so the
+  // least is a millimetre and a hundredth of a degree.
+  p.position_sigma = map.NumberOr("position_sigma", p.position_sigma, 1e-3, 100.0, "m");
+  p.yaw_sigma = map.NumberOr("yaw_sigma_deg", p.yaw_sigma * 180.0 / M_PI, 0.01, 180.0, "deg") * M_PI / 180.0;
   p.latency_median = map.NumberOr("latency_median", p.latency_median, 1e-3, 60.0, "s");
   p.latency_log_sigma = map.NumberOr("latency_log_sigma", p.latency_log_sigma, 0.0, 10.0);
   p.latency_max = map.NumberOr("latency_max", p.latency_max, 1e-3, 60.0, "s");

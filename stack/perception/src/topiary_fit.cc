@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace trimbot::perception {
 namespace {
@@ -32,12 +33,14 @@ struct WeightedRadial {
   Eigen::Vector3d point;
   double n, m, weight;
   AxesTied tied;
+  std::optional<double> base_height;  // the centre's height is then base + c (its own is held)
   template <typename T>
   bool operator()(const T* centre, const T* yaw, const T* axes, T* residual) const {
     const T* a = axes;
     const T* b = tied == AxesTied::kNone ? axes + 1 : axes;
     const T* c = tied == AxesTied::kAll ? axes : (tied == AxesTied::kHorizontal ? axes + 1 : axes + 2);
-    residual[0] = T(weight) * Radial(point, n, m, centre, yaw, a, b, c);
+    const T standing[3] = {centre[0], centre[1], base_height ? T(*base_height) + c[0] : centre[2]};
+    residual[0] = T(weight) * Radial(point, n, m, standing, yaw, a, b, c);
     return true;
   }
 };
@@ -83,6 +86,7 @@ std::optional<TopiaryFit> FitTopiary(const std::vector<Eigen::Vector3d>& points,
     shape.half = tied == AxesTied::kAll          ? Eigen::Vector3d::Constant(axes[0])
                  : tied == AxesTied::kHorizontal ? Eigen::Vector3d(axes[0], axes[0], axes[1])
                                                  : Eigen::Vector3d(axes[0], axes[1], axes[2]);
+    if (options.base_height) shape.centre.z() = *options.base_height + shape.half.z();
     for (std::size_t i = 0; i < points.size(); ++i) residuals[i] = shape.RadialDistance(points[i]);
   };
   update_residuals();
@@ -93,10 +97,11 @@ std::optional<TopiaryFit> FitTopiary(const std::vector<Eigen::Vector3d>& points,
     for (std::size_t i = 0; i < points.size(); ++i) {
       const double factor = residuals[i] > 0.0 ? options.quantile : 1.0 - options.quantile;
       const double weight = std::sqrt(factor / std::max(std::abs(residuals[i]), options.residual_floor));
-      problem.AddResidualBlock(
-          MakeCost(WeightedRadial{points[i], shape.horizontal_exponent, shape.vertical_exponent, weight, tied}),
-          nullptr, shape.centre.data(), &shape.yaw, axes);
+      problem.AddResidualBlock(MakeCost(WeightedRadial{points[i], shape.horizontal_exponent, shape.vertical_exponent,
+                                                       weight, tied, options.base_height}),
+                               nullptr, shape.centre.data(), &shape.yaw, axes);
     }
+    if (options.base_height) problem.SetManifold(shape.centre.data(), new ceres::SubsetManifold(3, {2}));
     for (int k = 0; k < FreeAxes(tied); ++k) problem.SetParameterLowerBound(axes, k, 0.02);
     ceres::Solver::Options solver;
     solver.max_num_iterations = 50;

@@ -57,8 +57,8 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
       kinematics_(description),
       T_cutter_blade_(description.BladeInCutter()),
       blade_radius_(description.BladeRadius()),
-      blade_thickness_(description.BladeThickness()),
       housing_radius_(description.ArmLinkCylinders().back().radius),  // link 6 carries the cutter
+      blade_thickness_(description.BladeThickness()),
       collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
       planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
   // One speed model for the path's costs and the trajectory that executes it.
@@ -180,7 +180,10 @@ void TrimExecutive::Fit(double stamp) {
   const std::vector<Eigen::Vector3d> bush = ScansOfTheBush();
   report_.points = static_cast<int>(bush.size());
   std::string failure;
-  const std::optional<perception::TopiaryFit> fit = FitTopiary(bush, expected_, tied_, parameters_.fit, &failure);
+  // The target stands on the plan's base, where the foliage starts (its foot hidden in the grass).
+  perception::TopiaryFitOptions options = parameters_.fit;
+  options.base_height = expected_.centre.z() - expected_.half.z();
+  const std::optional<perception::TopiaryFit> fit = FitTopiary(bush, expected_, tied_, options, &failure);
   if (!fit) {
     Finish(stamp, "no target shape from the scan: " + failure);
     return;

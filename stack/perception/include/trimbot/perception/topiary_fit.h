@@ -40,6 +40,11 @@ struct TopiaryFitOptions {
   int reweightings = 12;          // iterations of the reweighted least squares
   double residual_floor = 0.002;  // m: residuals are weighted as at least this (IRLS's epsilon)
   int min_points = 50;
+  // m, in the points' frame: where the target's bottom stands, when the garden plan says (a
+  // topiary's foliage starts at its base, on the ground). The foot is hidden in the grass, so
+  // without it the height and the vertical semi-axis trade off against each other: a box's fitted
+  // bottom wanders by a decimetre. Unset: the centre's height is fitted freely.
+  std::optional<double> base_height;
 };
 
 struct TopiaryFit {
