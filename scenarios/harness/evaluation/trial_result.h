@@ -131,6 +131,7 @@ struct TrimOutcome {
   double leaf_depth_m = 0.0;                // the leaves outside the fit as the stack saw them
   int moves_round_the_leaves = 0;           // of the arm's moves in and out (2), round the seen leaves
   int poses_left_out = 0;                   // blade poses at the path's ends with no way in or out round them
+  int poses_unseen = 0;                     // of the path's, aimed on the fit: the scan saw no leaves over it there
   int turns_round_the_leaves = 0;           // moves between blade poses out, round the seen leaves and in
   int arm_contacts = 0;                     // contact events of the arm (MuJoCo: the wood, the ground, itself)
   int foliage_touches = 0;                  // events of an arm link other than the blade reaching into the foliage
@@ -139,15 +140,13 @@ struct TrimOutcome {
 };
 // Fields missing from a result written before they were added read as their defaults (a suite
 // resumed over older batches).
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(TrimOutcome, goal, bush, success, cut, failure, within_2cm_before,
-                                                within_2cm_after, within_2cm_upper_before, within_2cm_upper_after,
-                                                overcut_share, within_2cm_at_trim_end, overcut_share_at_trim_end,
-                                                overgrowth_before_m3, overgrowth_after_m3, cutting_seconds,
-                                                trim_seconds, points, poses, reached_poses, from_database, path_source,
-                                                motion_seconds, nearest_neighbour_seconds, fit_centre_error_m,
-                                                fit_axes_error_max_m, fit_centre_offset_m, fit_half_m, leaf_depth_m,
-                                                moves_round_the_leaves, poses_left_out, turns_round_the_leaves,
-                                                arm_contacts, foliage_touches, foliage_touches_by, arm_contacts_by)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(
+    TrimOutcome, goal, bush, success, cut, failure, within_2cm_before, within_2cm_after, within_2cm_upper_before,
+    within_2cm_upper_after, overcut_share, within_2cm_at_trim_end, overcut_share_at_trim_end, overgrowth_before_m3,
+    overgrowth_after_m3, cutting_seconds, trim_seconds, points, poses, reached_poses, from_database, path_source,
+    motion_seconds, nearest_neighbour_seconds, fit_centre_error_m, fit_axes_error_max_m, fit_centre_offset_m,
+    fit_half_m, leaf_depth_m, moves_round_the_leaves, poses_left_out, poses_unseen, turns_round_the_leaves,
+    arm_contacts, foliage_touches, foliage_touches_by, arm_contacts_by)
 
 // A trim's wall-clock time beside its simulated time (issue 31: trimming one bush must not take
 // longer in wall time than in simulated time). Wall clock: timing.json only, never summary.json.

@@ -111,6 +111,7 @@ void TrimEvaluator::Record(const stack::TrimResult& result, double now) {
   o.leaf_depth_m = report.leaf_depth;
   o.moves_round_the_leaves = report.moves_round_the_leaves;
   o.poses_left_out = report.left_out;
+  o.poses_unseen = report.unseen;
   o.turns_round_the_leaves = report.turns_round_the_leaves;
   trim->planning_seconds = report.planning_seconds;
   if (trim->started >= 0.0) {

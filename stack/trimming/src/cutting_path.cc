@@ -57,7 +57,13 @@ Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eige
   return blade;
 }
 
-std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target, const CuttingPoseOptions& options) {
+Eigen::Isometry3d BladeSurface::PoseAt(const Eigen::Vector3d& direction, const Eigen::Vector3d& x_hint) const {
+  if (depth == 0.0 || (seen && !seen(direction))) return BladePoseAt(fit, direction, x_hint);
+  return BladePoseAt(aimed(), direction, x_hint);
+}
+
+std::vector<Eigen::Isometry3d> CuttingPoses(const BladeSurface& surface, const CuttingPoseOptions& options) {
+  const perception::TopiaryShape target = surface.aimed();
   // Directions from the centre on a Fibonacci sphere, as many as the surface holds blade spacings
   // (the surface of the ellipsoid through the semi-axes, Knud Thomsen's approximation).
   const Eigen::Vector3d& s = target.half;
@@ -73,7 +79,7 @@ std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& targ
     const double z = 1.0 - 2.0 * (k + 0.5) / count, r = std::sqrt(1.0 - z * z);
     const Eigen::Vector3d d =
         R_yaw * Eigen::Vector3d(r * std::cos(golden_angle * k), r * std::sin(golden_angle * k), z);
-    const Eigen::Isometry3d blade = BladePoseAt(target, d);
+    const Eigen::Isometry3d blade = surface.PoseAt(d);
     const Eigen::Vector3d point = blade.translation();
     if (point.z() < options.min_height) continue;
     const Eigen::Vector3d to_base = (Eigen::Vector3d(0.0, 0.0, point.z()) - point).normalized();

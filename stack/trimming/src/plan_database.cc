@@ -186,13 +186,13 @@ StoredCuttingPath ToStored(const CuttingPath& path, const perception::TopiarySha
 }
 
 CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
-                             const Eigen::VectorXd& start, const StoredCuttingPath& stored,
-                             const perception::TopiaryShape& target,
+                             const Eigen::VectorXd& start, const StoredCuttingPath& stored, const BladeSurface& surface,
                              const std::function<bool(const Eigen::VectorXd&)>& valid,
                              const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
                              const CuttingPathOptions& options) {
   CuttingPath path;
   path.configurations.push_back(start);
+  const perception::TopiaryShape target = surface.aimed();
   // From the stored target's frame to the new one's: its centre and yaw (the least turn that
   // gives the same shape: a round bush's poses stay on the side the base faces).
   const Eigen::Matrix3d turn =
@@ -200,7 +200,7 @@ CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::
   const Eigen::Isometry3d T_blade_cutter = T_cutter_blade.inverse();
   for (std::size_t k = 0; k < stored.blades.size(); ++k) {
     const Eigen::Vector3d direction = turn * (stored.blades[k].translation() - stored.target.centre).normalized();
-    const Eigen::Isometry3d blade = BladePoseAt(target, direction, turn * stored.blades[k].linear().col(0));
+    const Eigen::Isometry3d blade = surface.PoseAt(direction, turn * stored.blades[k].linear().col(0));
     const Eigen::VectorXd& previous = path.configurations.back();
     const bool first = path.configurations.size() == 1;  // the move from the start is the arm planner's
     std::optional<Eigen::VectorXd> q =

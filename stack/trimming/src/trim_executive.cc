@@ -105,6 +105,7 @@ void TrimExecutive::SetJointState(const messages::ArmJointState& joints) { joint
 void TrimExecutive::StandsAt(const Eigen::Isometry3d& T_now_scan) {
   if (mode_ != Mode::kFitted) return;
   target_shape_.centre = T_now_scan * target_shape_.centre;
+  for (Eigen::Vector3d& p : leaves_) p = T_now_scan * p;
   const Eigen::Vector3d x = T_now_scan.linear().col(0);
   target_shape_.yaw += std::atan2(x.y(), x.x());
   mode_ = Mode::kPlanning;
@@ -190,6 +191,7 @@ void TrimExecutive::Fit(double stamp) {
   }
   report_.fit = fit->shape;
   target_shape_ = fit->shape;
+  leaves_ = bush;
   std::vector<double> outside;
   for (const Eigen::Vector3d& p : bush) outside.push_back(std::max(0.0, fit->shape.RadialDistance(p)));
   report_.leaf_depth = Quantile(outside, parameters_.leaf_quantile);
@@ -208,8 +210,9 @@ void TrimExecutive::Plan(double stamp) {
       MakeCuttingChecks(kinematics_, T_cutter_blade_, collision_.get(), target, check_depth_, parameters_.planner,
                         [this](const Eigen::VectorXd& q) { return !ArmInLeaves(q); });
   planner_->ResetRoadmap();
-  // Where the blade goes: the fitted surface, or blade_depth inside it.
-  const perception::TopiaryShape blade_surface = Offset(target, -parameters_.blade_depth);
+  // Where the blade goes: blade_depth inside the fitted surface where the scan saw leaves over it.
+  const BladeSurface blade_surface(target, parameters_.blade_depth,
+                                   [this](const Eigen::Vector3d& d) { return LeavesSeenOver(d); });
   const Eigen::VectorXd start = ToVector(*joints_);
   CuttingPath path;
   double distance = 0.0;
@@ -244,6 +247,9 @@ void TrimExecutive::Plan(double stamp) {
     return;
   }
   report_.reached = static_cast<int>(path.poses.size());
+  for (const Eigen::Isometry3d& blade : path.blades) {
+    report_.unseen += LeavesSeenOver((blade.translation() - target.centre).normalized()) ? 0 : 1;
+  }
   report_.motion_time = path.motion_time;
   const std::vector<Eigen::VectorXd> waypoints = Waypoints(path, checks, &failure);
   report_.planning_seconds += SecondsSince(begin);
@@ -415,6 +421,21 @@ double TrimExecutive::MaxTilt(const std::vector<Eigen::VectorXd>& way) const {
     tilt = std::max(tilt, std::acos(std::clamp(inward.dot(blade.linear().col(2)), -1.0, 1.0)));
   }
   return tilt;
+}
+
+bool TrimExecutive::LeavesSeenOver(const Eigen::Vector3d& direction) const {
+  const Eigen::Isometry3d on_fit = BladePoseAt(target_shape_, direction);
+  const Eigen::Vector3d n = -on_fit.linear().col(2);
+  const int needed = static_cast<int>(std::ceil(1.0 / parameters_.fit.quantile - 1e-9));
+  int count = 0;
+  for (const Eigen::Vector3d& p : leaves_) {
+    const Eigen::Vector3d v = p - on_fit.translation();
+    const double along = v.dot(n);
+    if (std::abs(along) <= parameters_.scan_margin && (v - along * n).norm() <= blade_radius_ && ++count >= needed) {
+      return true;
+    }
+  }
+  return false;
 }
 
 double TrimExecutive::BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {

@@ -41,11 +41,33 @@ Eigen::Vector3d SurfaceNormal(const perception::TopiaryShape& target, const Eige
 Eigen::Isometry3d BladePoseAt(const perception::TopiaryShape& target, const Eigen::Vector3d& direction,
                               const Eigen::Vector3d& x_hint = Eigen::Vector3d::Zero());
 
-// Blade poses over the target's surface, facing the base at the origin: surface turned at most
+// `target` with its semi-axes moved `offset` outward (negative: inward, to 1 mm at least): on a box's
+// faces that moves the surface along its normal, where a move along the radii would move an oblique
+// part of a face by less. The surface the blade is aimed at and the collision checks' are both this.
+perception::TopiaryShape Offset(const perception::TopiaryShape& target, double offset);
+
+// Where the blade is aimed: `depth` inside the fitted target where the scan saw the leaves over
+// it, on the fit itself where it did not. The fit is the quantile of the leaf points' distances;
+// where there are none (a box's top, which the ring at 0.49 m sees edge-on) it is the shape's
+// extrapolation from the faces beside, no bound of the target under it.
+struct BladeSurface {
+  // Aimed on `target` everywhere (a target known as it is: planning offline, tests).
+  BladeSurface(const perception::TopiaryShape& target) : fit(target) {}  // NOLINT: implicit on purpose
+  BladeSurface(const perception::TopiaryShape& fit, double depth, std::function<bool(const Eigen::Vector3d&)> seen)
+      : fit(fit), depth(depth), seen(std::move(seen)) {}
+  perception::TopiaryShape fit;
+  double depth = 0.0;                                // m inside the fit where seen
+  std::function<bool(const Eigen::Vector3d&)> seen;  // by the unit direction from the centre; unset: all
+  perception::TopiaryShape aimed() const { return Offset(fit, -depth); }  // where it is seen
+  // BladePoseAt on the aimed surface, or on the fit where the direction was not seen.
+  Eigen::Isometry3d PoseAt(const Eigen::Vector3d& direction,
+                           const Eigen::Vector3d& x_hint = Eigen::Vector3d::Zero()) const;
+};
+
+// Blade poses over the surface, facing the base at the origin: surface turned at most
 // max_facing_angle from the base, and the crown's sector on the base's side (within 45 deg of its
 // bearing; the crown, surface turned up more than sideways, faces no standoff).
-std::vector<Eigen::Isometry3d> CuttingPoses(const perception::TopiaryShape& target,
-                                            const CuttingPoseOptions& options = {});
+std::vector<Eigen::Isometry3d> CuttingPoses(const BladeSurface& surface, const CuttingPoseOptions& options = {});
 
 struct CuttingPathOptions {
   int rolls = 6;                // blade rolls about its axis tried per pose
@@ -75,11 +97,6 @@ struct CuttingPath {
 // profile, the slowest joint sets it; continuous joints the short way round).
 double JointMoveTime(const arm::ArmKinematics& kinematics, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                      double velocity_scale, double acceleration);
-
-// `target` with its semi-axes moved `offset` outward (negative: inward, to 1 mm at least): on a box's
-// faces that moves the surface along its normal, where a move along the radii would move an oblique
-// part of a face by less. The surface the blade is aimed at and the collision checks' are both this.
-perception::TopiaryShape Offset(const perception::TopiaryShape& target, double offset);
 
 // The arm's collision model's environment: the ground and Offset(target, offset) as a solid convex
 // polyhedron.

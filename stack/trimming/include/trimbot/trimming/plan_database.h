@@ -54,14 +54,13 @@ class CuttingPathDatabase {
 // The stored path of a solved one (its blades, configurations and time).
 StoredCuttingPath ToStored(const CuttingPath& path, const perception::TopiaryShape& target);
 
-// The stored path adapted to `target`, as described above. Where the move from the previous pose
+// The stored path adapted to `surface`, as described above. Where the move from the previous pose
 // to a pose's solution near the stored one is refused, the pose takes the solution with the quickest
 // free move (counted in refused_moves), else the valid one nearest in time, the move to it planned
 // round the target (as a tour's refused move is); a pose with no valid solution is left out (in
 // `unreachable`, by its index in the stored path). Not ok when no pose fits: plan in full then.
 CuttingPath AdaptCuttingPath(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
-                             const Eigen::VectorXd& start, const StoredCuttingPath& stored,
-                             const perception::TopiaryShape& target,
+                             const Eigen::VectorXd& start, const StoredCuttingPath& stored, const BladeSurface& surface,
                              const std::function<bool(const Eigen::VectorXd&)>& valid,
                              const std::function<bool(const Eigen::VectorXd&, const Eigen::VectorXd&)>& free_move,
                              const CuttingPathOptions& options = {});

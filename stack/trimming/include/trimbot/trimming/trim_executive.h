@@ -82,6 +82,7 @@ struct TrimReport {
   int moves_round_the_leaves = 0;       // of the moves in and out (2 at most): round the leaves, then along the
                                         // blade's axis (the others round the shrunk target only: no such way found)
   int left_out = 0;                     // blade poses at the path's ends left out: no way in or out round the leaves
+  int unseen = 0;                       // of the path's blade poses, aimed on the fit: no leaves seen over it there
   int turns_round_the_leaves = 0;       // moves between blade poses out along the axis, round the leaves and in:
                                         // those that turn the blade too far to stay in the swath it cuts or
                                         // tilt it too far off the surface on the way (MaxTurnInLeaves), and
@@ -171,6 +172,10 @@ class TrimExecutive {
   // cutter's link trails the blade in the swath it cuts (MaxTurnInLeaves); the others - the upper
   // arm reaching over a bush's near edge - would push through leaves no blade has cut.
   bool ArmInLeaves(const Eigen::VectorXd& q) const;
+  // Whether the scan saw leaves over the fitted surface along a unit direction from its centre: at
+  // least as many of the fit's points (1 / the fit's quantile: enough for one to lie inside it) within
+  // the blade's radius of the surface point's normal and scan_margin of the point along it.
+  bool LeavesSeenOver(const Eigen::Vector3d& direction) const;
   // The angle between the blade's axes at two arm configurations.
   double BladeTurn(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
 
@@ -194,6 +199,7 @@ class TrimExecutive {
   Eigen::Isometry3d T_map_base_ = Eigen::Isometry3d::Identity();  // estimated, at the scan
   std::map<int, std::vector<Eigen::Vector3d>> scans_;             // each bush's scans, map frame
   perception::TopiaryShape target_shape_;                         // fitted, in the current base_link
+  std::vector<Eigen::Vector3d> leaves_;                           // the fit's points, in the current base_link
   double check_depth_ = 0.0;  // m into target_shape_ the collision checks let the blade go (CheckDepth)
   std::vector<Eigen::Vector3d> points_;
   std::vector<Eigen::Matrix3d> covariances_;
