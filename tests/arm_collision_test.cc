@@ -92,6 +92,50 @@ TEST(CollisionModel, HomeIsFreeAndNoCheckedPairTouchesEverywhere) {
   EXPECT_GT(free, 200);  // a folded arm hits the ring or base often, but far from always
 }
 
+// A model built with a body clearance refuses the configurations that bring a moving link closer
+// than that to the robot's body (base, ring, arm mount), and those only (the body's shapes are
+// grown, not rounded: a box's corner reaches sqrt(3) times as far), and leaves the arm's links
+// among themselves as they are; the arm's home keeps it.
+TEST(CollisionModel, MovingLinksKeepTheBodyClearanceFromTheRobotsBody) {
+  const RobotDescription robot = Robot();
+  constexpr double kClearance = 0.01;
+  const CollisionModel exact(robot, robot.ArmJointNames());
+  const CollisionModel padded(robot, robot.ArmJointNames(), kClearance);
+  const RobotParameters parameters = RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(parameters.arm_home_position.data(), 6);
+  EXPECT_FALSE(padded.Check(home).collision);
+  const auto is_body = [&](const std::string& label) {
+    const std::vector<std::string>& moving = exact.moving_links();
+    return std::none_of(moving.begin(), moving.end(), [&](const std::string& m) { return label.rfind(m, 0) == 0; });
+  };
+  CollisionCheckOptions self_distance;
+  self_distance.environment = false;
+  self_distance.distance = true;
+  Configurations configurations(robot);
+  int near_body = 0, clear = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const Eigen::VectorXd q = configurations.Next();
+    const CollisionReport report = exact.Check(q, self_distance);
+    if (report.collision) continue;
+    const bool body_pair = is_body(report.closest.first) || is_body(report.closest.second);
+    if (body_pair && report.clearance < kClearance - 1e-4) {
+      ++near_body;
+      EXPECT_TRUE(padded.Check(q, self_distance).collision) << report.clearance << " m from the body";
+    } else if (report.clearance > std::sqrt(3.0) * kClearance + 1e-4) {  // a grown box's corner: sqrt(3) out
+      ++clear;
+      EXPECT_FALSE(padded.Check(q, self_distance).collision) << report.clearance << " m clear";
+    } else if (!body_pair) {
+      // Two arm links closer than the clearance, the body farther: no clearance between arm links.
+      const CollisionReport p = padded.Check(q, self_distance);
+      if (p.collision) {
+        EXPECT_TRUE(is_body(p.pair.first) || is_body(p.pair.second)) << p.pair.first << " - " << p.pair.second;
+      }
+    }
+  }
+  EXPECT_GT(near_body, 0);
+  EXPECT_GT(clear, 100);
+}
+
 // The clearance to the ground against the lowest point of each moving cylinder, computed from the
 // URDF's link poses without FCL: z_min = centre - half_length |a_z| - radius sqrt(1 - a_z^2).
 TEST(CollisionModel, GroundClearanceMatchesTheLowestPointOfTheArm) {

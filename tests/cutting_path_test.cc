@@ -472,13 +472,16 @@ std::string LinkInLeaves(const robot::RobotDescription& robot, const garden::Fol
 
 // What the arm touched running a trim's trajectory (the base at the map's origin), the blade cutting
 // the bush's true leaves as it sweeps (as the simulator does), sampled every 0.02 s (the blade moves
-// 1 cm at most, swept in between).
+// 1 cm at most, swept in between); and the arm against itself, the robot's body and the ground (the
+// URDF's shapes, as MuJoCo collides them) every millisecond.
 struct TrimReplay {
   std::map<std::string, int> touches;              // link touch events, by stage
   std::map<std::string, int> touches_by;           // the same by "<link> while <stage>"
   std::map<std::string, int> near;                 // samples within 2 cm of the leaves, the blade clear of them
   double within_before = 0.0, within_after = 0.0;  // share of the surface within 2 cm of the target
   double overcut = 0.0;                            // share of the target's volume cut away
+  std::map<std::string, int> robot_contacts;       // ms an arm link touches the robot or the ground, by pair
+  double least_clearance = 1.0;  // m: the arm's from itself, the robot's body and the ground (every 10 ms)
 };
 
 TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive& trim, garden::Foliage* foliage) {
@@ -493,6 +496,17 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
   replay.within_before = foliage->Measure().surface_within_tolerance;
   bool touching = false;
   garden::BladeDisc last = sample(0.0).second;
+  robot::CollisionModel collision(robot, robot.ArmJointNames());
+  collision.environment().AddGround("ground", 0.0);
+  robot::CollisionCheckOptions distance;
+  distance.distance = true;
+  for (int ms = 0; ms <= static_cast<int>(1000.0 * trajectory.duration()); ++ms) {
+    Eigen::VectorXd q, velocity;
+    trajectory.Sample(0.001 * ms, &q, &velocity);
+    const robot::CollisionReport report = collision.Check(q, ms % 10 == 0 ? distance : robot::CollisionCheckOptions{});
+    if (report.collision) ++replay.robot_contacts[report.pair.first + " with " + report.pair.second];
+    if (ms % 10 == 0) replay.least_clearance = std::min(replay.least_clearance, report.clearance);
+  }
   for (double t = 0.02; t <= trajectory.duration(); t += 0.02) {
     const auto [q, disc] = sample(t);
     foliage->Cut(last, disc);
@@ -568,6 +582,7 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
   EXPECT_EQ(replay.touches["moving out"], 0);
   EXPECT_EQ(replay.near["moving in"], 0);
   EXPECT_EQ(replay.near["moving out"], 0);
+  EXPECT_TRUE(replay.robot_contacts.empty()) << "the arm touched itself, the robot's body or the ground";
   std::printf(
       "round the leaves seen %.1f cm deep: link touches moving in %d, cutting %d, moving out %d; within 2 cm of "
       "the leaves, the blade clear: moving in %d, moving out %d samples\n",
@@ -642,6 +657,11 @@ TEST(TrimExecutive, TrimsABoxFromItsCorner) {
       100.0 * replay.within_after, 100.0 * replay.overcut, replay.touches["moving in"], replay.touches["cutting"],
       replay.touches["moving out"]);
   for (const auto& [what, count] : replay.touches_by) std::printf("  %s: %d\n", what.c_str(), count);
+  for (const auto& [what, count] : replay.robot_contacts)
+    std::printf("  robot contact %s: %d ms\n", what.c_str(), count);
+  std::printf("  least clearance of the arm from itself, the robot and the ground: %.1f mm\n",
+              1000.0 * replay.least_clearance);
+  EXPECT_TRUE(replay.robot_contacts.empty()) << "the arm touched itself, the robot's body or the ground";
   EXPECT_EQ(replay.touches["moving in"], 0);
   EXPECT_EQ(replay.touches["cutting"], 0) << "the housing turned out of the swath the blade cut";
   EXPECT_EQ(replay.touches["moving out"], 0);

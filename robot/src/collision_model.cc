@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <stdexcept>
 
 #include "trimbot/common/input_error.h"
 
@@ -15,18 +16,21 @@ namespace {
 
 using Geometry = std::shared_ptr<fcl::CollisionGeometryd>;
 
-Geometry UrdfGeometry(const urdf::Geometry& g, const std::string& urdf_path, const std::string& link) {
+// The URDF's collision geometry grown by `padding` on every side.
+Geometry UrdfGeometry(const urdf::Geometry& g, const std::string& urdf_path, const std::string& link,
+                      double padding = 0.0) {
   switch (g.type) {
     case urdf::Geometry::BOX: {
       const auto& box = static_cast<const urdf::Box&>(g);
-      return std::make_shared<fcl::Boxd>(box.dim.x, box.dim.y, box.dim.z);
+      return std::make_shared<fcl::Boxd>(box.dim.x + 2.0 * padding, box.dim.y + 2.0 * padding,
+                                         box.dim.z + 2.0 * padding);
     }
     case urdf::Geometry::CYLINDER: {
       const auto& cylinder = static_cast<const urdf::Cylinder&>(g);
-      return std::make_shared<fcl::Cylinderd>(cylinder.radius, cylinder.length);
+      return std::make_shared<fcl::Cylinderd>(cylinder.radius + padding, cylinder.length + 2.0 * padding);
     }
     case urdf::Geometry::SPHERE:
-      return std::make_shared<fcl::Sphered>(static_cast<const urdf::Sphere&>(g).radius);
+      return std::make_shared<fcl::Sphered>(static_cast<const urdf::Sphere&>(g).radius + padding);
     default:
       throw InputError(urdf_path, "link '" + link + "': only box, cylinder and sphere collision geometry is supported");
   }
@@ -142,6 +146,9 @@ struct CollisionModel::Robot {
     std::string label;
     Eigen::Isometry3d origin;  // in the link
     std::unique_ptr<fcl::CollisionObjectd> object;
+    // A link of the robot's body (not moved by the varied joints): grown by the body clearance, as
+    // the moving links see it.
+    std::unique_ptr<fcl::CollisionObjectd> padded;
   };
   std::vector<Link> links;  // parents before children
   std::vector<Shape> shapes;
@@ -184,8 +191,10 @@ struct CollisionModel::Robot {
   }
 };
 
-CollisionModel::CollisionModel(const RobotDescription& description, const std::vector<std::string>& varied_joints)
+CollisionModel::CollisionModel(const RobotDescription& description, const std::vector<std::string>& varied_joints,
+                               double body_clearance)
     : robot_(std::make_unique<Robot>()) {
+  if (!(body_clearance >= 0.0)) throw std::invalid_argument("CollisionModel: the body clearance is negative");
   const urdf::ModelInterface& urdf = description.urdf();
   robot_->AddLinkTree(urdf, varied_joints);
   for (const auto& name : varied_joints) {
@@ -223,6 +232,10 @@ CollisionModel::CollisionModel(const RobotDescription& description, const std::v
       shape.origin = ToIsometry(collision->origin);
       shape.object =
           std::make_unique<fcl::CollisionObjectd>(UrdfGeometry(*collision->geometry, description.path(), link->name));
+      if (!robot_->links[i].moving) {
+        shape.padded = std::make_unique<fcl::CollisionObjectd>(
+            UrdfGeometry(*collision->geometry, description.path(), link->name, body_clearance));
+      }
       (robot_->links[i].moving ? robot_->moving_shapes : robot_->static_shapes)
           .push_back(static_cast<int>(robot_->shapes.size()));
       robot_->shapes.push_back(std::move(shape));
@@ -262,6 +275,10 @@ CollisionReport CollisionModel::Check(const Eigen::VectorXd& q, const CollisionC
     const Eigen::Isometry3d pose = poses[shape.link] * shape.origin;
     shape.object->setTransform(pose.rotation(), pose.translation());
     shape.object->computeAABB();
+    if (shape.padded) {
+      shape.padded->setTransform(pose.rotation(), pose.translation());
+      shape.padded->computeAABB();
+    }
   }
 
   CollisionReport report;
@@ -294,9 +311,11 @@ CollisionReport CollisionModel::Check(const Eigen::VectorXd& q, const CollisionC
 
   if (options.self) {
     for (const auto& [a, b] : robot.self_pairs) {
-      if (test(*robot.shapes[a].object, *robot.shapes[b].object, robot.shapes[a].label, robot.shapes[b].label)) {
-        return report;
-      }
+      const Robot::Shape &sa = robot.shapes[a], &sb = robot.shapes[b];
+      // A moving link against the body keeps the body clearance (one of the two does not move).
+      const fcl::CollisionObjectd& oa = sa.padded ? *sa.padded : *sa.object;
+      const fcl::CollisionObjectd& ob = sb.padded ? *sb.padded : *sb.object;
+      if (test(oa, ob, sa.label, sb.label)) return report;
     }
   }
   if (options.environment) {

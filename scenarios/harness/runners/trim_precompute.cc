@@ -45,12 +45,12 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
   const robot::RobotFiles files = paths.robot_files();
   const robot::RobotDescription robot = robot::RobotDescription::Load(files.urdf);
   const arm::ArmKinematics kinematics(robot);
-  robot::CollisionModel collision(robot, robot.ArmJointNames());
   const auto parameters = robot::RobotParameters::Load(files.robot_parameters);
   const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(parameters.arm_home_position.data(), 6);
   const Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
   // The stack's own: stored paths are the ones it would plan.
   const trimming::TrimParameters trim = stack::StackParameters::Load(files.stack_parameters).Trim();
+  robot::CollisionModel collision(robot, robot.ArmJointNames(), trim.planner.body_clearance);
   trimming::CuttingPathOptions path_options = trim.path;
   path_options.velocity_scale = trim.planner.velocity_scale;
   path_options.acceleration = trim.planner.acceleration;

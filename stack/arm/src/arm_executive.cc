@@ -80,7 +80,8 @@ const char* ToString(ArmExecutive::Mode mode) {
 ArmExecutive::ArmExecutive(const robot::RobotDescription& description, const ArmExecutiveParameters& parameters)
     : parameters_(parameters),
       kinematics_(description),
-      collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
+      collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames(),
+                                                         parameters.planner.body_clearance)),
       planner_(std::make_unique<ArmPlanner>(kinematics_, *collision_, parameters.planner)),
       description_(description) {
   collision_->environment().AddGround("ground", parameters_.ground_clearance);

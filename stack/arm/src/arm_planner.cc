@@ -146,6 +146,14 @@ JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& waypoints, 
   return Timed(pieces, sample_period);
 }
 
+std::vector<Eigen::VectorXd> JointSteps(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double step) {
+  const Eigen::VectorXd d = to - from;
+  const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / step)));
+  std::vector<Eigen::VectorXd> states;
+  for (int k = 1; k <= steps; ++k) states.push_back(from + d * (static_cast<double>(k) / steps));
+  return states;
+}
+
 std::vector<Eigen::Isometry3d> PosesAlongLine(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double step) {
   const Eigen::AngleAxisd turn(from.linear().transpose() * to.linear());
   const double distance = (to.translation() - from.translation()).norm();
@@ -395,13 +403,13 @@ ArmPlan ArmPlanner::CartesianPass(const Eigen::VectorXd& start, const Eigen::Iso
     } else if ((*q - previous).cwiseAbs().maxCoeff() > parameters_.cartesian_max_joint_step) {
       plan.failure = "the arm would switch branch" + at.str();
     } else {
-      const int checks =
-          std::max(1, static_cast<int>(std::ceil((*q - previous).cwiseAbs().maxCoeff() / parameters_.collision_step)));
-      for (int c = 1; c <= checks && plan.failure.empty(); ++c) {
-        const robot::CollisionReport report = collision_.Check(previous + (*q - previous) * c / checks);
+      for (const Eigen::VectorXd& state : JointSteps(previous, *q, parameters_.collision_step)) {
+        const robot::CollisionReport report = collision_.Check(state);
         ++plan.validity_checks;
-        if (report.collision)
+        if (report.collision) {
           plan.failure = "collision (" + report.pair.first + " - " + report.pair.second + ")" + at.str();
+          break;
+        }
       }
     }
     if (!plan.failure.empty()) break;

@@ -230,6 +230,7 @@ void ReadArm(Reader& r, arm::ArmExecutiveParameters& p) {
     f.Number("acceleration", &o.acceleration, 0.01, 100.0, "rad/s^2");
     f.Number("cartesian_step", &o.cartesian_step, 1e-4, 0.1, "m");
     f.Number("cartesian_max_joint_step", &o.cartesian_max_joint_step, 1e-3, 1.0, "rad");
+    f.Number("body_clearance", &o.body_clearance, 0.0, 0.1, "m");
     f.Integer("ik_database_seeds", &o.ik.database_seeds, 0, 100000);
     f.Integer("ik_starts", &o.ik.starts, 0, 10000);
     if (o.ik.database_seeds + o.ik.starts == 0) f.map().Fail("ik_starts", "inverse kinematics needs seeds or starts");

@@ -154,19 +154,25 @@ std::vector<Eigen::VectorXd> BladeLine(const arm::ArmKinematics& kinematics, con
   // No joint turns more than cartesian_max_joint_step a step: b on another branch is out of reach.
   const double most = arm_parameters.cartesian_max_joint_step * static_cast<double>(line.size());
   if (kinematics.JointDifference(a, b).cwiseAbs().maxCoeff() > most) return {};
+  // A step may turn a joint up to cartesian_max_joint_step: checked in between as any motion is.
+  const auto checked = [&](const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
+    if (!valid) return true;
+    const std::vector<Eigen::VectorXd> states = arm::JointSteps(from, to, arm_parameters.collision_step);
+    return std::all_of(states.begin(), states.end(), valid);
+  };
   std::vector<Eigen::VectorXd> configurations;
   Eigen::VectorXd previous = a;
   for (std::size_t k = 0; k + 1 < line.size(); ++k) {
     const std::optional<Eigen::VectorXd> q =
         kinematics.InverseKinematicsNear(line[k] * T_blade_cutter, previous, arm_parameters.ik);
     if (!q || (*q - previous).cwiseAbs().maxCoeff() > arm_parameters.cartesian_max_joint_step) return {};
-    if (valid && !valid(*q)) return {};
+    if (!checked(previous, *q)) return {};
     configurations.push_back(*q);
     previous = *q;
   }
   const Eigen::VectorXd end = previous + kinematics.JointDifference(previous, b);  // b, on the way's unwrapping
   if ((end - previous).cwiseAbs().maxCoeff() > arm_parameters.cartesian_max_joint_step) return {};  // another branch
-  if (valid && !valid(end)) return {};
+  if (!checked(previous, end)) return {};
   configurations.push_back(end);
   return configurations;
 }
@@ -182,10 +188,8 @@ CuttingChecks MakeCuttingChecks(const arm::ArmKinematics& kinematics, const Eige
   };
   checks.way = [&kinematics, T_cutter_blade, arm_parameters, valid = checks.valid](const Eigen::VectorXd& a,
                                                                                    const Eigen::VectorXd& b) {
-    const Eigen::VectorXd d = kinematics.JointDifference(a, b);
-    const int steps = std::max(1, static_cast<int>(std::ceil(d.cwiseAbs().maxCoeff() / arm_parameters.collision_step)));
-    std::vector<Eigen::VectorXd> way;
-    for (int k = 1; k <= steps; ++k) way.push_back(a + d * (static_cast<double>(k) / steps));
+    const std::vector<Eigen::VectorXd> way =
+        arm::JointSteps(a, a + kinematics.JointDifference(a, b), arm_parameters.collision_step);
     if (std::all_of(way.begin(), way.end(), valid)) return way;
     return BladeLine(kinematics, T_cutter_blade, a, b, arm_parameters, valid);
   };

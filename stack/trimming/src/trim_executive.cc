@@ -59,7 +59,8 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
       blade_radius_(description.BladeRadius()),
       housing_radius_(description.ArmLinkCylinders().back().radius),  // link 6 carries the cutter
       blade_thickness_(description.BladeThickness()),
-      collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames())),
+      collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames(),
+                                                         parameters.planner.body_clearance)),
       planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
   // One speed model for the path's costs and the trajectory that executes it.
   parameters_.path.velocity_scale = parameters.planner.velocity_scale;

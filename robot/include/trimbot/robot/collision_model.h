@@ -72,7 +72,8 @@ struct CollisionCheckOptions {
 struct CollisionReport {
   bool collision = false;
   std::pair<std::string, std::string> pair;  // the first pair found in contact ("link/#k" or environment name)
-  // With options.distance: the smallest distance between the pairs checked (0 in contact), and its pair.
+  // With options.distance: the smallest distance between the pairs checked (0 in contact), and its pair
+  // (a pair with the robot's body: beyond its body clearance).
   double clearance = 0.0;
   std::pair<std::string, std::string> closest;
 };
@@ -80,9 +81,13 @@ struct CollisionReport {
 class CollisionModel {
  public:
   // Every <collision> (box, cylinder, sphere) of every link; `varied_joints` are the joints whose
-  // positions the checks take (others stay at zero). Throws InputError naming the URDF for a mesh
-  // collision geometry or an unknown joint.
-  CollisionModel(const RobotDescription& description, const std::vector<std::string>& varied_joints);
+  // positions the checks take (others stay at zero). A moving link and one of the robot's body (a
+  // link the varied joints do not move: the base, the camera ring, the arm's mount) collide closer
+  // than `body_clearance` (m): the margin a planner keeps for the arm's tracking error (the body's
+  // boxes and cylinders grown by it on every side, so up to sqrt(3) times that at a corner). Throws
+  // InputError naming the URDF for a mesh collision geometry or an unknown joint.
+  CollisionModel(const RobotDescription& description, const std::vector<std::string>& varied_joints,
+                 double body_clearance = 0.0);
   ~CollisionModel();
   CollisionModel(CollisionModel&&) noexcept;
   CollisionModel& operator=(CollisionModel&&) noexcept;

@@ -33,6 +33,8 @@ struct ArmPlannerParameters {
   double acceleration = 1.5;              // rad/s^2 per joint
   double cartesian_step = 0.005;          // m of cutter travel between inverse-kinematics steps of a pass
   double cartesian_max_joint_step = 0.1;  // rad per step: more means the arm would switch branch
+  // m the arm keeps from the robot's own body (the CollisionModel its planner checks is built with it).
+  double body_clearance = 0.01;
   IkOptions ik;
 };
 
@@ -101,6 +103,10 @@ class ArmPlanner {
 // Cartesian line): the profile does not slow for corners.
 JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& waypoints, const Eigen::VectorXd& velocity_limits,
                                  double acceleration, const std::vector<bool>& stops = {}, double sample_period = 0.02);
+
+// The joint vectors after `from` up to `to` along the straight joint-space line between them, no
+// joint turning more than `step` from one to the next: the states a motion is checked at.
+std::vector<Eigen::VectorXd> JointSteps(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double step);
 
 // The poses after `from` up to `to` along the straight line between them (position linearly,
 // orientation by the shortest rotation), `step` metres of travel or 10 * `step` radians of turn

@@ -118,7 +118,8 @@ double CheckDepth(const perception::TopiaryShape& target, double aimed_depth, do
 // next. The configurations after `a`, the last one `b` (continuous joints unwrapped along the
 // way); empty when the arm loses the line, would switch branch (a step over
 // cartesian_max_joint_step), arrives at another solution than b, or `valid` (when given) refuses a
-// step.
+// configuration on the way (checked collision_step apart in joint space, as any motion is: a step
+// near the wrist's singularity turns a joint up to cartesian_max_joint_step).
 std::vector<Eigen::VectorXd> BladeLine(const arm::ArmKinematics& kinematics, const Eigen::Isometry3d& T_cutter_blade,
                                        const Eigen::VectorXd& a, const Eigen::VectorXd& b,
                                        const arm::ArmPlannerParameters& arm_parameters,
@@ -129,8 +130,8 @@ std::vector<Eigen::VectorXd> BladeLine(const arm::ArmKinematics& kinematics, con
 // blade may go that deep. `also_valid`, when given, is a further condition on each configuration
 // (the executive's: no arm link but the cutter's in the leaves the scan saw). A move between two
 // configurations is the straight joint move where its configurations collision_step apart (rad,
-// continuous joints the short way round) are valid, else the blade line (BladeLine) where each of
-// its steps is (5 mm of blade travel apart: what lies between is checked by neither).
+// continuous joints the short way round) are valid, else the blade line (BladeLine) where its
+// configurations are.
 struct CuttingChecks {
   std::function<bool(const Eigen::VectorXd&)> valid;
   // The configurations of the move from a to b after a (the last b, unwrapped from a), checked;
