@@ -533,9 +533,15 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
 // The trim of `foliage` from a base at the map's origin: the leaves facing `towards` seen (as stereo
 // would), the target fitted to them, the path planned and its trajectory made. Coarse (for the
 // test's time): 0.15 m between blade poses, 2 rolls, one restart of the search.
+// `earlier`: scans of the bush before it (scan goals), each the leaves facing `towards` from a
+// base truly at the map's origin, placed by a pose estimate `T_map_base`.
+struct EarlierScan {
+  Eigen::Vector3d towards;
+  Eigen::Isometry3d T_map_base;
+};
 std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, const garden::Foliage& foliage,
                                         const perception::TopiaryShape& expected, perception::AxesTied tied,
-                                        const Eigen::Vector3d& towards) {
+                                        const Eigen::Vector3d& towards, const std::vector<EarlierScan>& earlier = {}) {
   const auto robot_parameters = robot::RobotParameters::Load(testing::SourcePath("robot/config/robot_parameters.yaml"));
   Rng rng = MakeRng(5, "leaves");
   // The arm's OMPL planners seeded as RobotStack seeds them for a run: once per process (OMPL draws
@@ -552,6 +558,11 @@ std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, co
   messages::ArmJointState joints;
   joints.position = robot_parameters.arm_home_position;
   trim->SetJointState(joints);
+  for (const EarlierScan& scan : earlier) {
+    trim->Start(0.0, expected, tied, 1, scan.T_map_base, false);
+    trim->SetPerceivedPoints(LeavesSeenFrom(foliage, Eigen::Isometry3d::Identity(), scan.towards, rng), {});
+    trim->Update(0.1);
+  }
   trim->Start(0.0, expected, tied, 1, Eigen::Isometry3d::Identity());
   trim->SetPerceivedPoints(LeavesSeenFrom(foliage, Eigen::Isometry3d::Identity(), towards, rng), {});
   trim->Update(0.1);
@@ -588,6 +599,35 @@ TEST(TrimExecutive, MovesInAndOutRoundTheLeavesItSaw) {
       "the leaves, the blade clear: moving in %d, moving out %d samples\n",
       100.0 * trim->report().leaf_depth, replay.touches["moving in"], replay.touches["cutting"],
       replay.touches["moving out"], replay.near["moving in"], replay.near["moving out"]);
+}
+
+// An earlier scan of the side the robot now cuts, placed 2.5 cm deeper into the bush by its pose
+// estimate, does not pull the fit - the inner envelope of the points - into the target there:
+// where this scan saw the side itself, the earlier scans' points are left out, and the blade aimed
+// blade_depth inside the fit leaves the target whole.
+TEST(TrimExecutive, AnEarlierScanOfTheSameSidePlacedDeeperDoesNotPullTheFitIn) {
+  const robot::RobotDescription robot = robot::RobotDescription::Load(testing::SourcePath("robot/urdf/trimbot.urdf"));
+  const garden::GardenObject bush = TopiaryBall({0.95, 0.0});
+  garden::Foliage foliage = garden::Foliage::Grown(bush, 4, 0.33);
+  perception::TopiaryShape expected;
+  expected.centre = foliage.pose().translation();
+  expected.half = Eigen::Vector3d::Constant(0.3);
+  Eigen::Isometry3d deeper = Eigen::Isometry3d::Identity();
+  deeper.translation().x() = 0.025;  // the near side's points 2.5 cm into the bush
+  const auto trim =
+      PlanTrim(robot, foliage, expected, perception::AxesTied::kAll, -Eigen::Vector3d::UnitX(),
+               {{Eigen::Vector3d::UnitX(), Eigen::Isometry3d::Identity()}, {-Eigen::Vector3d::UnitX(), deeper}});
+  ASSERT_EQ(trim->mode(), TrimExecutive::Mode::kCutting) << trim->report().failure;
+  ASSERT_TRUE(trim->report().fit);
+  const perception::TopiaryShape& fit = *trim->report().fit;
+  const double near_face = fit.centre.x() - fit.half.x(), target_face = 0.95 - 0.3;
+  const TrimReplay replay = ReplayTrim(robot, *trim, &foliage);
+  std::printf("the fit's near face %.1f cm outside the target's; within 2 cm %.1f %% -> %.1f %%, over-cut %.3f %%\n",
+              100.0 * (target_face - near_face), 100.0 * replay.within_before, 100.0 * replay.within_after,
+              100.0 * replay.overcut);
+  EXPECT_GT(target_face - near_face, 0.01) << "the fit's near face outside the target by more than blade_depth";
+  EXPECT_LT(replay.overcut, 1e-4);
+  EXPECT_GT(replay.within_after, replay.within_before + 0.02);
 }
 
 // The blade goes blade_depth inside the fit where the scan saw leaves over it, on the fit where it

@@ -256,6 +256,7 @@ void ReadTrim(Reader& r, trimming::TrimParameters& p) {
   r.Number("min_height", &p.min_height, 0.0, 1.0, "m");
   r.Number("max_point_sigma", &p.max_point_sigma, 1e-4, 10.0, "m");
   r.Integer("max_points", &p.max_points, 10, 10000000);
+  r.Number("scan_overlap", &p.scan_overlap, 0.0, 1.0, "m");
   r.Number("fit_quantile", &p.fit.quantile, 0.01, 0.99);
   r.Number("pose_spacing", &p.poses.spacing, 0.01, 1.0, "m");
   r.Degrees("max_facing_angle_deg", &p.poses.max_facing_angle, 1.0, 180.0);

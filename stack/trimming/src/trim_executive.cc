@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "trimbot/common/points_kd_tree.h"
 #include "trimbot/common/wall_clock.h"
 
 namespace trimbot::trimming {
@@ -126,17 +127,30 @@ std::vector<Eigen::Vector3d> TrimExecutive::BushPoints() const {
 }
 
 std::vector<Eigen::Vector3d> TrimExecutive::ScansOfTheBush() {
-  // This scan joins the bush's earlier ones in the map frame (by the pose estimate at each).
-  std::vector<Eigen::Vector3d>& scans = scans_[bush_];
-  for (const Eigen::Vector3d& p : BushPoints()) scans.push_back(T_map_base_ * p);
-  // Thinned evenly to max_points (the fit's time is linear in them), in base_link now.
-  const double stride = std::max(1.0, static_cast<double>(scans.size()) / parameters_.max_points);
+  std::vector<Eigen::Vector3d> seen = BushPoints();
+  std::vector<Eigen::Vector3d>& scans = scans_[bush_];  // map frame
   const Eigen::Isometry3d T_base_map = T_map_base_.inverse();
-  std::vector<Eigen::Vector3d> points;
-  for (double k = 0.0; k < static_cast<double>(scans.size()); k += stride) {
-    points.push_back(T_base_map * scans[static_cast<std::size_t>(k)]);
+  std::vector<Eigen::Vector3d> points = seen;
+  if (!seen.empty()) {
+    const PointsAdaptor adaptor{seen};
+    PointsKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree.buildIndex();
+    const double overlap = parameters_.scan_overlap * parameters_.scan_overlap;
+    for (const Eigen::Vector3d& earlier : scans) {
+      const Eigen::Vector3d p = T_base_map * earlier;
+      std::uint32_t index = 0;
+      double d2 = 0.0;
+      if (tree.knnSearch(p.data(), 1, &index, &d2) == 1 && d2 > overlap) points.push_back(p);
+    }
   }
-  return points;
+  for (const Eigen::Vector3d& p : seen) scans.push_back(T_map_base_ * p);  // joins them for later scans
+  // Thinned evenly to max_points (the fit's time is linear in them).
+  const double stride = std::max(1.0, static_cast<double>(points.size()) / parameters_.max_points);
+  std::vector<Eigen::Vector3d> thinned;
+  for (double k = 0.0; k < static_cast<double>(points.size()); k += stride) {
+    thinned.push_back(points[static_cast<std::size_t>(k)]);
+  }
+  return thinned;
 }
 
 std::optional<messages::ArmCommand> TrimExecutive::Update(double stamp) {

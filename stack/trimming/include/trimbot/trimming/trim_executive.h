@@ -49,6 +49,8 @@ struct TrimParameters {
   double min_height = 0.05;       // m above the ground: lower points are grass
   double max_point_sigma = 0.05;  // m: less certain stereo points are not used
   int max_points = 5000;          // more are thinned evenly (the fit's time is linear in them)
+  // m: a point of an earlier scan this close to one of this scan is of a part this scan saw itself
+  double scan_overlap = 0.05;
   perception::TopiaryFitOptions fit;
   CuttingPoseOptions poses;
   CuttingPathOptions path;
@@ -137,7 +139,11 @@ class TrimExecutive {
   void Finish(double stamp, const std::string& failure);
   // The scan's stereo points within scan_margin of the expected target's surface, above the grass.
   std::vector<Eigen::Vector3d> BushPoints() const;
-  // This scan's bush points and the bush's earlier scans (map frame), thinned, in base_link.
+  // This scan's bush points and, where this scan saw nothing within scan_overlap, the bush's
+  // earlier scans (map frame, placed by the pose estimate at each), thinned, in base_link. Where two
+  // scans saw the same part, each placed by its own estimate (1-2 cm apart), the fit's quantile
+  // - the inner envelope of all points - followed the one placed deepest, and the blade aimed by it
+  // cut into the target on the side the robot faces; this scan is the robot's own view of that side.
   std::vector<Eigen::Vector3d> ScansOfTheBush();
   // The joint path through the cutting path's configurations (its free moves as `checks` make them,
   // planned moves round the target), continuous joints unwrapped from the start, and stops_; empty
