@@ -127,21 +127,20 @@ std::vector<Eigen::Vector3d> TrimExecutive::BushPoints() const {
 }
 
 std::vector<Eigen::Vector3d> TrimExecutive::ScansOfTheBush() {
-  std::vector<Eigen::Vector3d> seen = BushPoints();
+  const std::vector<Eigen::Vector3d> seen = BushPoints();
   std::vector<Eigen::Vector3d>& scans = scans_[bush_];  // map frame
   const Eigen::Isometry3d T_base_map = T_map_base_.inverse();
+  const PointsAdaptor adaptor{seen};
+  PointsKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  tree.buildIndex();
+  const double overlap = parameters_.scan_overlap * parameters_.scan_overlap;
   std::vector<Eigen::Vector3d> points = seen;
-  if (!seen.empty()) {
-    const PointsAdaptor adaptor{seen};
-    PointsKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    tree.buildIndex();
-    const double overlap = parameters_.scan_overlap * parameters_.scan_overlap;
-    for (const Eigen::Vector3d& earlier : scans) {
-      const Eigen::Vector3d p = T_base_map * earlier;
-      std::uint32_t index = 0;
-      double d2 = 0.0;
-      if (tree.knnSearch(p.data(), 1, &index, &d2) == 1 && d2 > overlap) points.push_back(p);
-    }
+  for (const Eigen::Vector3d& earlier : scans) {
+    const Eigen::Vector3d p = T_base_map * earlier;
+    std::uint32_t index = 0;
+    double d2 = 0.0;
+    // Nothing of this scan near (or no point at all): a part only the earlier scans saw.
+    if (tree.knnSearch(p.data(), 1, &index, &d2) == 0 || d2 > overlap) points.push_back(p);
   }
   for (const Eigen::Vector3d& p : seen) scans.push_back(T_map_base_ * p);  // joins them for later scans
   // Thinned evenly to max_points (the fit's time is linear in them).
