@@ -530,15 +530,17 @@ TrimReplay ReplayTrim(const robot::RobotDescription& robot, const TrimExecutive&
   return replay;
 }
 
-// The trim of `foliage` from a base at the map's origin: the leaves facing `towards` seen (as stereo
-// would), the target fitted to them, the path planned and its trajectory made. Coarse (for the
-// test's time): 0.15 m between blade poses, 2 rolls, one restart of the search.
-// `earlier`: scans of the bush before it (scan goals), each the leaves facing `towards` from a
-// base truly at the map's origin, placed by a pose estimate `T_map_base`.
+// A scan of the bush before the trim (a scan goal): the leaves facing `towards` from a base truly at
+// the map's origin, placed by a pose estimate `T_map_base`.
 struct EarlierScan {
   Eigen::Vector3d towards;
   Eigen::Isometry3d T_map_base;
 };
+
+// The trim of `foliage` from a base at the map's origin, after the `earlier` scans: the leaves
+// facing `towards` seen (as stereo would), the target fitted to them, the path planned and its
+// trajectory made. Coarse (for the test's time): 0.15 m between blade poses, 2 rolls, one restart
+// of the search.
 std::unique_ptr<TrimExecutive> PlanTrim(const robot::RobotDescription& robot, const garden::Foliage& foliage,
                                         const perception::TopiaryShape& expected, perception::AxesTied tied,
                                         const Eigen::Vector3d& towards, const std::vector<EarlierScan>& earlier = {}) {

@@ -141,7 +141,7 @@ class TrimExecutive {
   std::vector<Eigen::Vector3d> BushPoints() const;
   // This scan's bush points and, where this scan saw nothing within scan_overlap, the bush's
   // earlier scans (map frame, placed by the pose estimate at each), thinned, in base_link. Where two
-  // scans saw the same part, each placed by its own estimate (1-2 cm apart), the fit's quantile
+  // scans saw the same part, each placed by its own estimate (1-3 cm apart), the fit's quantile
   // - the inner envelope of all points - followed the one placed deepest, and the blade aimed by it
   // cut into the target on the side the robot faces; this scan is the robot's own view of that side.
   std::vector<Eigen::Vector3d> ScansOfTheBush();
