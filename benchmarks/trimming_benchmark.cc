@@ -1,7 +1,10 @@
 // Trimming's planning times (issue 31): the GTSP solvers on instances of the cutting path's size,
 // and the full cutting path over a ball in front of the robot (blade poses, inverse kinematics of
 // every pose and roll, joint move times, the search and its lazy collision checks), and the plan
-// adapted from a stored path (issue 31's target: <= 100 ms per bush) beside it.
+// adapted from a stored path (issue 31's target: <= 100 ms per bush) beside it. Both with the
+// stack's own trim settings (robot/config/stack.yaml: pose spacing, rolls, the search's restarts,
+// the arm's clearance from the robot's body, the blade's depth), as `trimbot trim precompute`
+// solves and the trim executive adapts.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -9,6 +12,7 @@
 #include "trimbot/common/random.h"
 #include "trimbot/robot/collision_model.h"
 #include "trimbot/robot/robot_parameters.h"
+#include "trimbot/stack/stack_parameters.h"
 #include "trimbot/trimming/cutting_path.h"
 #include "trimbot/trimming/plan_database.h"
 
@@ -55,8 +59,9 @@ BENCHMARK(BM_GtspSearch)->Args({12, 5})->Args({30, 12})->Args({40, 20})->Unit(be
 // The robot's arm with its collision model, and a 0.6 m ball 0.95 m ahead.
 struct BallInFront {
   robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
+  trimming::TrimParameters trim = stack::StackParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/stack.yaml").Trim();
   arm::ArmKinematics kinematics{robot};
-  robot::CollisionModel collision{robot, robot.ArmJointNames()};
+  robot::CollisionModel collision{robot, robot.ArmJointNames(), trim.planner.body_clearance};
   Eigen::VectorXd home;
   Eigen::Isometry3d T_cutter_blade = robot.BladeInCutter();
   perception::TopiaryShape target;
@@ -66,14 +71,20 @@ struct BallInFront {
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
     target.centre = {0.95, 0.0, 0.35};
     target.half = Eigen::Vector3d::Constant(0.3);
-    kinematics.PrepareDatabase();
+    kinematics.PrepareDatabase(trim.path.ik);
   }
+  // The checks for a blade aimed `depth` inside `shape`, as the trim executive makes them.
+  trimming::CuttingChecks Checks(const perception::TopiaryShape& shape, double depth) {
+    return trimming::MakeCuttingChecks(kinematics, T_cutter_blade, &collision, shape,
+                                       trimming::CheckDepth(shape, depth, trim.poses.spacing, robot.BladeThickness()),
+                                       trim.planner);
+  }
+  // The blade on the target, the search as the stack runs it online (trimbot trim precompute runs
+  // GLNS's slower default mode).
   trimming::CuttingPath PlanInFull() {
-    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(
-        kinematics, T_cutter_blade, &collision, target,
-        trimming::CheckDepth(target, 0.0, trimming::CuttingPoseOptions{}.spacing, robot.BladeThickness()));
-    return trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target), checks.valid,
-                                     checks.free_move);
+    const trimming::CuttingChecks checks = Checks(target, 0.0);
+    return trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target, trim.poses),
+                                     checks.valid, checks.free_move, trim.PathOptions());
   }
 };
 
@@ -81,7 +92,7 @@ void BM_CuttingPathOverABall(benchmark::State& state) {
   BallInFront ball;
   trimming::CuttingPath path;
   for (auto _ : state) path = ball.PlanInFull();
-  state.counters["poses"] = static_cast<double>(trimming::CuttingPoses(ball.target).size());
+  state.counters["poses"] = static_cast<double>(trimming::CuttingPoses(ball.target, ball.trim.poses).size());
   state.counters["reachable"] = path.clusters;
   state.counters["tour_s"] = path.motion_time;
   state.counters["nearest_neighbour_s"] = path.nearest_neighbour_time;
@@ -104,12 +115,13 @@ void BM_AdaptStoredPath(benchmark::State& state) {
     const double angle = 2.0 * M_PI * UniformUnit(rng), offset = 0.02 + 0.03 * UniformUnit(rng);
     moved.centre += offset * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
     moved.half = Eigen::Vector3d::Constant(0.27 + 0.06 * UniformUnit(rng));
-    const trimming::CuttingChecks checks = trimming::MakeCuttingChecks(
-        ball.kinematics, ball.T_cutter_blade, &ball.collision, moved,
-        trimming::CheckDepth(moved, 0.0, trimming::CuttingPoseOptions{}.spacing, ball.robot.BladeThickness()));
+    const trimming::CuttingChecks checks = ball.Checks(moved, ball.trim.blade_depth);
+    // The blade aimed blade_depth inside the fit all over (leaves seen everywhere).
+    const trimming::BladeSurface surface(moved, ball.trim.blade_depth, [](const Eigen::Vector3d&) { return true; });
     state.ResumeTiming();
-    const trimming::CuttingPath adapted = trimming::AdaptCuttingPath(ball.kinematics, ball.T_cutter_blade, ball.home,
-                                                                     stored, moved, checks.valid, checks.free_move);
+    const trimming::CuttingPath adapted =
+        trimming::AdaptCuttingPath(ball.kinematics, ball.T_cutter_blade, ball.home, stored, surface, checks.valid,
+                                   checks.free_move, ball.trim.PathOptions());
     kept += static_cast<double>(adapted.poses.size()) / static_cast<double>(full.poses.size());
     time_ratio += adapted.ok ? adapted.motion_time / full.motion_time : 0.0;
     ++adaptations;

@@ -51,10 +51,7 @@ int RunTrimPrecompute(const TrimPrecomputeOptions& options, const ProjectPaths& 
   // The stack's own: stored paths are the ones it would plan.
   const trimming::TrimParameters trim = stack::StackParameters::Load(files.stack_parameters).Trim();
   robot::CollisionModel collision(robot, robot.ArmJointNames(), trim.planner.body_clearance);
-  trimming::CuttingPathOptions path_options = trim.path;
-  path_options.velocity_scale = trim.planner.velocity_scale;
-  path_options.acceleration = trim.planner.acceleration;
-  path_options.ik = trim.planner.ik;
+  trimming::CuttingPathOptions path_options = trim.PathOptions();
   path_options.search = trimming::GtspSearchOptions{};  // offline: GLNS's default mode in full
   trimming::CuttingPathDatabase database;
   for (std::size_t s = 0; s < shapes.size(); ++s) {

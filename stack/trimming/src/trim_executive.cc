@@ -53,6 +53,14 @@ const char* ToString(TrimExecutive::Mode mode) {
   return "?";
 }
 
+CuttingPathOptions TrimParameters::PathOptions() const {
+  CuttingPathOptions options = path;
+  options.velocity_scale = planner.velocity_scale;
+  options.acceleration = planner.acceleration;
+  options.ik = planner.ik;
+  return options;
+}
+
 TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const TrimParameters& parameters)
     : parameters_(parameters),
       kinematics_(description),
@@ -63,10 +71,7 @@ TrimExecutive::TrimExecutive(const robot::RobotDescription& description, const T
       collision_(std::make_unique<robot::CollisionModel>(description, description.ArmJointNames(),
                                                          parameters.planner.body_clearance)),
       planner_(std::make_unique<arm::ArmPlanner>(kinematics_, *collision_, parameters.planner)) {
-  // One speed model for the path's costs and the trajectory that executes it.
-  parameters_.path.velocity_scale = parameters.planner.velocity_scale;
-  parameters_.path.acceleration = parameters.planner.acceleration;
-  parameters_.path.ik = parameters.planner.ik;
+  parameters_.path = parameters.PathOptions();
   const std::vector<robot::LinkCylinder> cylinders = description.ArmLinkCylinders();
   const std::vector<std::string>& links = kinematics_.links();
   for (std::size_t c = 0; c + 1 < cylinders.size(); ++c) {  // the last, link 6, carries the cutter

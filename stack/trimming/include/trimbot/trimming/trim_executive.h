@@ -61,6 +61,10 @@ struct TrimParameters {
   arm::ArmPlannerParameters planner;    // the moves round the bush; its speeds time the whole cut
   double settle_tolerance = 0.002;      // rad
   double settle_timeout = 3.0;          // s
+
+  // `path` with the planner's speeds and inverse kinematics: one speed model for the path's costs,
+  // the trajectory that executes it and the stored paths of trimbot trim precompute.
+  CuttingPathOptions PathOptions() const;
 };
 
 // How the trim went, as the stack knows it.
