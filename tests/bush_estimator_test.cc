@@ -87,6 +87,26 @@ TEST(BushFit, SaysWhyWhenNothingIsThere) {
   EXPECT_NE(why.find("points near the expected bush"), std::string::npos) << why;
 }
 
+// The standoff keeps its gap from the outline on the side it stands: an elongated ellipsoid seen
+// from its long side is half its short extent deep (until 2026-12-07 the base stood half the
+// difference of the extents too far there, out of the arm's reach on Wageningen's bush 34).
+TEST(BushShape, AStandoffIsMeasuredFromTheOutlineOnItsSide) {
+  BushShape bush;
+  bush.size = {0.9, 0.5, 0.4};
+  bush.yaw = 0.3;
+  EXPECT_NEAR(bush.StandoffRadius(0.3), 0.45, 1e-12);               // the long axis' end
+  EXPECT_NEAR(bush.StandoffRadius(0.3 + M_PI / 2.0), 0.25, 1e-12);  // the long side
+  EXPECT_NEAR(bush.StandoffRadius(0.3 - M_PI / 2.0), 0.25, 1e-12);
+  // In between: the outline point along that bearing lies on the ellipse.
+  for (double bearing = -3.0; bearing < 3.2; bearing += 0.37) {
+    const double r = bush.StandoffRadius(bearing);
+    const double u = r * std::cos(bearing - bush.yaw), v = r * std::sin(bearing - bush.yaw);
+    EXPECT_NEAR(u * u / (0.45 * 0.45) + v * v / (0.25 * 0.25), 1.0, 1e-9) << bearing;
+  }
+  bush.kind = BushShape::Kind::kBox;  // stood at its corners: the larger half extent, as before
+  EXPECT_NEAR(bush.StandoffRadius(0.3 + M_PI / 4.0), 0.45, 1e-12);
+}
+
 // Rendered: the robot drives at a bush from 3.3 m to 0.9 m (ring centre to bush centre); the front
 // pair's cloud is fitted every 0.4 s. The rose has grown since the survey (growth 0.7). The expected centre handed to
 // the fit is 12 cm off (a map or localization error), the bush's yaw as the survey gives it.

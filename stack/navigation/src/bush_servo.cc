@@ -35,14 +35,14 @@ const char* ToString(BushServo::Mode mode) {
 BushServo::BushServo(const BushServoParameters& parameters, const Eigen::Vector2d& arm_axis)
     : parameters_(parameters), arm_axis_(arm_axis) {}
 
-void BushServo::Expect(const Eigen::Vector2d& expected_centre, double surveyed_radius) {
-  if (tracking() && (centre() - expected_centre).norm() > parameters_.max_jump + surveyed_radius) {
+void BushServo::Expect(const Eigen::Vector2d& expected_centre, double outline_radius) {
+  if (tracking() && (centre() - expected_centre).norm() > parameters_.max_jump + outline_radius) {
     weighted_sum_.setZero();  // what was tracked was something else
     weight_ = 0.0;
     candidate_.reset();
   }
   expected_ = expected_centre;
-  target_distance_ = surveyed_radius + parameters_.surface_gap;
+  target_distance_ = outline_radius + parameters_.surface_gap;
 }
 
 void BushServo::Start(double stamp) {

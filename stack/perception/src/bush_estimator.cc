@@ -8,6 +8,14 @@
 #include <memory>
 
 namespace trimbot::perception {
+
+double BushShape::StandoffRadius(double bearing) const {
+  if (kind == Kind::kBox) return Radius();
+  const double a = 0.5 * size.x(), b = 0.5 * size.y();
+  const double c = std::cos(bearing - yaw) / a, s = std::sin(bearing - yaw) / b;
+  return 1.0 / std::sqrt(c * c + s * s);
+}
+
 namespace {
 
 // A point of the bush: horizontal position in the fit's frame and height above the ground.

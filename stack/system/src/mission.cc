@@ -105,8 +105,13 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
   // the bush), the nearest to where the robot comes from whose approach point the outline fits at
   // facing the bush (the servo turns there to face it); failing that, one where it fits at all.
   // A goal that names its side: the free side nearest to it, within kSideTolerance.
-  const double standoff = goal.bush->Radius() + parameters_.bush_approach.servo.surface_gap;
-  const double reach = standoff + parameters_.bush_approach.approach_margin + arm_axis_.x();
+  // The arm's axis surface_gap from the outline on that side, the approach point approach_margin further.
+  const auto standoff = [&](double side) {
+    return goal.bush->StandoffRadius(side) + parameters_.bush_approach.servo.surface_gap;
+  };
+  const auto reach = [&](double side) {
+    return standoff(side) + parameters_.bush_approach.approach_margin + arm_axis_.x();
+  };
   // Sides every 10 deg; a box only towards its corners (+-15 deg), where two faces show: seen
   // face-on, a box's centre along the face rests on its two leafy edges alone (3 deg off measured).
   std::vector<double> sides;
@@ -130,8 +135,8 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
     double best_score = 0.0;
     for (const double angle : sides) {
       const Eigen::Vector2d side(std::cos(angle), std::sin(angle));
-      const Eigen::Vector2d approach = goal.position + reach * side;
-      const Eigen::Vector2d at_standoff = goal.position + (standoff + arm_axis_.x()) * side;
+      const Eigen::Vector2d approach = goal.position + reach(angle) * side;
+      const Eigen::Vector2d at_standoff = goal.position + (standoff(angle) + arm_axis_.x()) * side;
       const Pose2 facing{at_standoff.x(), at_standoff.y(), angle + M_PI};
       const bool fits = facing_the_bush ? navigator.planner().Valid({approach.x(), approach.y(), angle + M_PI})
                                         : navigator.planner().FreeHeading(approach).has_value();
@@ -150,7 +155,7 @@ Eigen::Vector2d Mission::ApproachPoint(const Goal& goal, const Eigen::Vector2d& 
   const Eigen::Vector2d away = goal.side ? Eigen::Vector2d(std::cos(*goal.side), std::sin(*goal.side))
                                : (from - goal.position).norm() > 1e-6 ? (from - goal.position).normalized()
                                                                       : Eigen::Vector2d(-1.0, 0.0);
-  return goal.position + reach * away;
+  return goal.position + reach(std::atan2(away.y(), away.x())) * away;
 }
 
 void Mission::StartSegment(Navigator* navigator) {
@@ -163,6 +168,8 @@ void Mission::StartSegment(Navigator* navigator) {
     const Goal& goal = goals_[static_cast<std::size_t>(i)];
     if (goal.bush) {
       points.push_back(ApproachPoint(goal, from, *navigator));
+      const Eigen::Vector2d side = points.back().position - goal.position;
+      approach_side_ = std::atan2(side.y(), side.x());
       bush_goal_ = i;
       break;
     }
@@ -181,7 +188,7 @@ void Mission::StartSegment(Navigator* navigator) {
 
 void Mission::ExpectBush() {
   const Goal& goal = goals_[static_cast<std::size_t>(bush_goal_)];
-  servo_.Expect(Apply(MapFromServoFrame().inverse(), goal.position), goal.bush->Radius());
+  servo_.Expect(Apply(MapFromServoFrame().inverse(), goal.position), goal.bush->StandoffRadius(approach_side_));
 }
 
 void Mission::CountSighting(bool tracked) {

@@ -95,6 +95,7 @@ class Mission {
   std::vector<Goal> goals_;
   int next_goal_ = 0;
   int bush_goal_ = -1;
+  double approach_side_ = 0.0;  // rad, map: the bearing from the bush goal's centre to its approach point
   bool servoing_ = false;
   bool trimming_ = false;          // from the bush approach's end to the trim's
   Pose2 advance_from_;             // the servo frame's pose where the approach ended (the scan's)

@@ -50,8 +50,10 @@ class BushServo {
   BushServo(const BushServoParameters& parameters, const Eigen::Vector2d& arm_axis);
 
   // The bush to track: believed at `expected_centre` (odometry frame, from the map and the pose
-  // estimate), with its surveyed radius. Clears the track if it is far from that belief (a new bush).
-  void Expect(const Eigen::Vector2d& expected_centre, double surveyed_radius);
+  // estimate), its surveyed outline `outline_radius` from the centre on the side approached (the
+  // standoff's surface gap is measured from it). Clears the track if it is far from that belief (a
+  // new bush).
+  void Expect(const Eigen::Vector2d& expected_centre, double outline_radius);
   // Starts driving at `stamp` (measurements are tracked from Expect on, driving or not).
   void Start(double stamp);
   // A frame's centre of the bush in base_link, with the odometry pose at the frame's stamp.

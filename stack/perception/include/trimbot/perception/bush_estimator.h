@@ -25,6 +25,11 @@ struct BushShape {
   double yaw = 0.0;                                       // rad, of its x axis in the fit's frame
   // m: half the larger horizontal extent.
   double Radius() const { return 0.5 * std::max(size.x(), size.y()); }
+  // m from the centre to the outline a standoff towards `bearing` (rad, the frame of `yaw`) keeps
+  // its gap from: an ellipsoid's or cylinder's elliptic outline there (an elongated bush seen from
+  // its long side is half its short extent deep, not half its long one); a box's Radius() (its
+  // standoffs face its corners, where the blade cuts the two faces beside them).
+  double StandoffRadius(double bearing) const;
 };
 
 struct BushFitOptions {
