@@ -120,6 +120,43 @@ TEST(RobotStack, DrivesAKinematicBaseAroundAnObstacleToItsGoal) {
   EXPECT_GT(closest_to_block, 0.5 + 0.3) << "the path keeps the base clear of the block";
 }
 
+// A bush whose servo gives up (here: no ring images, so it never sees the bush and times out) ends
+// the mission, or with navigation.stop_on_failure false goes as a point goal given up does: the
+// robot drives on to the next goal (a batch of trims reports the bush and trims the rest).
+TEST(RobotStack, ABushNotReachedEndsTheMissionOnlyWhenGoalsGivenUpDo) {
+  for (const bool stop_on_failure : {true, false}) {
+    StackParameters parameters = StackParameters::Load(Files().stack_parameters);
+    parameters.localization = LocalizationSource::kNone;
+    parameters.navigation.stop_on_failure = stop_on_failure;
+    parameters.bush_approach.servo.timeout = 5.0;
+    RobotStack stack(Files(), parameters, 5);
+    stack.SetInitialPose(0.0, {0.0, 0.0, 0.0});
+    stack.SetMap(WriteMap());
+    perception::BushShape bush;
+    bush.size = {0.6, 0.6, 0.5};
+    stack.SetGoals({Goal::ApproachBush({2.0, -2.5}, bush), Goal(6.0, 2.0)});
+    UnicyclePlant plant({0.0, 0.0, 0.0});
+    messages::BaseVelocityCommand command;
+    int bush_given_up = 0;
+    while (plant.time() < 120.0 && stack.telemetry().mission != MissionState::kDone &&
+           stack.telemetry().mission != MissionState::kFailed) {
+      plant.Step(stack, command.linear, command.angular);
+      const messages::RobotCommands commands = stack.Update(plant.time());
+      if (commands.base) command = *commands.base;
+      for (const NavigationEvent& e : stack.telemetry().events) {
+        bush_given_up += e.type == NavigationEvent::Type::kGoalFailed && e.goal == 0 ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(bush_given_up, 1) << "stop_on_failure " << stop_on_failure;
+    if (stop_on_failure) {
+      EXPECT_EQ(stack.telemetry().mission, MissionState::kFailed);
+    } else {
+      EXPECT_EQ(stack.telemetry().mission, MissionState::kDone);
+      EXPECT_LT(std::hypot(plant.pose().x - 6.0, plant.pose().y - 2.0), 0.15);
+    }
+  }
+}
+
 TEST(RobotStack, PoseFixesAreUsedOnlyWhenASourceIsConfigured) {
   for (const auto source : {LocalizationSource::kNone, LocalizationSource::kSimulatedPoseFixes}) {
     StackParameters parameters = StackParameters::Load(Files().stack_parameters);

@@ -233,8 +233,13 @@ void Mission::FinishBushGoal(double stamp, bool reached, const std::string& deta
   event.position = Apply(MapFromServoFrame(), servo_.centre());  // the bush's centre as tracked
   telemetry->events.push_back(event);
   servoing_ = false;
-  if (!reached) {
+  if (!reached && parameters_.navigation.stop_on_failure) {
     failed_ = true;
+    return;
+  }
+  if (!reached) {  // given up as the navigator gives up a point goal: on to the next goal
+    next_goal_ = bush_goal_ + 1;
+    StartSegment(navigator);
     return;
   }
   if (goals_[static_cast<std::size_t>(bush_goal_)].trim) {
