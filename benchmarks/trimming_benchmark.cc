@@ -60,6 +60,7 @@ BENCHMARK(BM_GtspSearch)->Args({12, 5})->Args({30, 12})->Args({40, 20})->Unit(be
 struct BallInFront {
   robot::RobotDescription robot = robot::RobotDescription::Load(TRIMBOT_SOURCE_DIR "/robot/urdf/trimbot.urdf");
   trimming::TrimParameters trim = stack::StackParameters::Load(TRIMBOT_SOURCE_DIR "/robot/config/stack.yaml").Trim();
+  trimming::CuttingPathOptions path = trim.PathOptions();  // the planner's speeds and inverse kinematics
   arm::ArmKinematics kinematics{robot};
   robot::CollisionModel collision{robot, robot.ArmJointNames(), trim.planner.body_clearance};
   Eigen::VectorXd home;
@@ -71,7 +72,7 @@ struct BallInFront {
     home = Eigen::Map<const Eigen::VectorXd>(p.arm_home_position.data(), 6);
     target.centre = {0.95, 0.0, 0.35};
     target.half = Eigen::Vector3d::Constant(0.3);
-    kinematics.PrepareDatabase(trim.path.ik);
+    kinematics.PrepareDatabase(path.ik);
   }
   // The checks for a blade aimed `depth` inside `shape`, as the trim executive makes them.
   trimming::CuttingChecks Checks(const perception::TopiaryShape& shape, double depth) {
@@ -84,7 +85,7 @@ struct BallInFront {
   trimming::CuttingPath PlanInFull() {
     const trimming::CuttingChecks checks = Checks(target, 0.0);
     return trimming::PlanCuttingPath(kinematics, T_cutter_blade, home, trimming::CuttingPoses(target, trim.poses),
-                                     checks.valid, checks.free_move, trim.PathOptions());
+                                     checks.valid, checks.free_move, path);
   }
 };
 
@@ -119,9 +120,8 @@ void BM_AdaptStoredPath(benchmark::State& state) {
     // The blade aimed blade_depth inside the fit all over (leaves seen everywhere).
     const trimming::BladeSurface surface(moved, ball.trim.blade_depth, [](const Eigen::Vector3d&) { return true; });
     state.ResumeTiming();
-    const trimming::CuttingPath adapted =
-        trimming::AdaptCuttingPath(ball.kinematics, ball.T_cutter_blade, ball.home, stored, surface, checks.valid,
-                                   checks.free_move, ball.trim.PathOptions());
+    const trimming::CuttingPath adapted = trimming::AdaptCuttingPath(
+        ball.kinematics, ball.T_cutter_blade, ball.home, stored, surface, checks.valid, checks.free_move, ball.path);
     kept += static_cast<double>(adapted.poses.size()) / static_cast<double>(full.poses.size());
     time_ratio += adapted.ok ? adapted.motion_time / full.motion_time : 0.0;
     ++adaptations;

@@ -237,17 +237,14 @@ void Mission::FinishBushGoal(double stamp, bool reached, const std::string& deta
     failed_ = true;
     return;
   }
-  if (!reached) {  // given up as the navigator gives up a point goal: on to the next goal
-    next_goal_ = bush_goal_ + 1;
-    StartSegment(navigator);
-    return;
-  }
-  if (goals_[static_cast<std::size_t>(bush_goal_)].trim) {
+  if (reached && goals_[static_cast<std::size_t>(bush_goal_)].trim) {
     StartTrim(stamp);
     return;
   }
+  // The rest of the mission (none: the navigator is done); a bush not reached is given up as the
+  // navigator gives up a point goal.
   next_goal_ = bush_goal_ + 1;
-  StartSegment(navigator);  // the rest of the mission (none: the navigator is done)
+  StartSegment(navigator);
 }
 
 void Mission::StartTrim(double stamp) {
